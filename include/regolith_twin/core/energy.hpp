@@ -1,0 +1,22 @@
+// Energy bookkeeping and contact statistics computed on demand from a state.
+#pragma once
+
+#include "regolith_twin/core/state.hpp"
+
+namespace rt {
+
+struct Energy {
+  double translational = 0;  // sum 1/2 m v^2, J
+  double rotational = 0;     // sum 1/2 I w^2, J
+  double potential = 0;      // gravitational, -sum m g.x, J
+  double elastic = 0;        // springs of live contacts (normal, tangential, rolling, twisting), J
+  double kinetic() const { return translational + rotational; }
+  double total() const { return translational + rotational + potential + elastic; }
+};
+
+Energy energy(const Model& m, const State& s);
+
+// Mean number of grain-grain contacts per free grain (2 * pairs / grains).
+double coordination_number(const Model& m, const State& s);
+
+}  // namespace rt

@@ -1,0 +1,149 @@
+// Static description of a DEM scene: grain sizes and masses, materials, the
+// contact-law table for every pair type, walls, gravity, time step and guard
+// thresholds. A Model is built once (see ModelBuilder in scene/) and is then
+// read-only: every stage of the step takes `const Model&` and a mutable State.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "regolith_twin/core/types.hpp"
+
+namespace rt {
+
+// Contact law family used for every pair in a scene.
+enum class ContactModel { Linear, HertzMindlin };
+
+// A material as published (MODEL.md §9) plus elastic constants for Hertz.
+struct Material {
+  std::string name;
+  double density = 2430.0;  // kg/m^3 (grains; unused for walls)
+  double eps_n = 0.5;       // normal coefficient of restitution (0, 1]
+  double eps_t = 0.5;       // tangential "restitution" (pkdgrav damping parameter)
+  double mu_s = 1.0;        // sliding friction coefficient
+  double mu_r = 0.0;        // rolling friction coefficient (0 = no rolling resistance)
+  double mu_t = 0.0;        // twisting friction coefficient (0 = no twisting resistance)
+  double beta = 1.0;        // shape parameter (grain angularity), dimensionless
+  double young = 0.0;       // Young's modulus E, Pa (Hertz–Mindlin only)
+  double poisson = 0.25;    // Poisson ratio (Hertz–Mindlin only)
+  // Optional overrides of the linear law (<= 0: derived from eps_t / k_n).
+  double kt_over_kn = 2.0 / 7.0;  // k_t / k_n
+  double ct_over_cn = -1.0;       // if > 0, C_t = ct_over_cn * C_n instead of from eps_t
+  // A structure material (walls, impactors, bodies) gives a pair its own
+  // restitution and takes the grain's friction unless own_friction is set.
+  bool structure = false;
+  bool own_friction = false;
+};
+
+// Contact-law constants of one pair type (material a with material b, or a
+// grain material with a wall). Mass-dependent terms are stored as coefficients
+// of sqrt(m*) so one table entry serves every grain size.
+struct PairLaw {
+  double eps_n = 1, eps_t = 1;  // restitution of this pair type
+  // linear law
+  double kn = 0.0;     // normal stiffness, N/m
+  double kt = 0.0;     // tangential stiffness, N/m
+  double cn_coef = 0;  // C_n = cn_coef * sqrt(m*), N s/m
+  double ct_coef = 0;  // C_t = ct_coef * sqrt(m*)
+  // Hertz–Mindlin
+  double e_star = 0;   // effective Young's modulus E*, Pa
+  double g_star = 0;   // effective shear modulus G*, Pa
+  double hm_damp = 0;  // gamma = hm_damp * sqrt(S_n m*)
+  // friction and resistance
+  double mu_s = 0;     // sliding friction
+  double mu_r = 0;     // rolling friction
+  double mu_t = 0;     // twisting friction
+  double beta = 0;     // shape parameter
+  bool rolling = false;   // rolling resistance active for this pair type
+  bool twisting = false;  // twisting resistance active for this pair type
+};
+
+// Analytic, infinite-mass wall shapes (MODEL.md §5).
+enum class WallType { Plane, Disk, Cylinder, Cone, Rectangle, SphereShell };
+
+struct Wall {
+  WallType type = WallType::Plane;
+  std::string name;
+  Vec3 origin = Vec3::Zero();  // a point on the plane / centre of disk, base centre of cylinder or cone, rectangle centre, sphere centre
+  Vec3 axis = Vec3::UnitZ();   // unit normal (plane, disk, rectangle) or axis (cylinder, cone)
+  Vec3 u = Vec3::UnitX();      // rectangle: first in-plane unit direction (v = axis x u)
+  double radius = 0;           // disk, cylinder, sphere shell; cone: radius at origin
+  double radius2 = 0;          // cone: radius at origin + length*axis
+  double length = 0;           // cylinder/cone: extent along axis (<= 0: infinite cylinder)
+  double half_u = 0, half_v = 0;  // rectangle half extents along u and v
+  bool inner = true;           // cylinder/cone/sphere: grains live inside (true) or outside
+  int law_material = 0;        // index of the wall's material (its eps, and friction unless set)
+};
+
+// Guard thresholds: a run that crosses them stops with a diagnostic.
+struct Guards {
+  double max_overlap_ratio = 0.25;  // overlap / smaller radius of the pair
+  double min_steps_per_contact_warn = 10;
+  double min_steps_per_contact_refuse = 4;
+  bool allow_under_resolved = false;
+};
+
+struct Model {
+  // --- grains (indexed by grain id; the State keeps its own sorted copies) ---
+  int n_grains = 0;
+  std::vector<double> grain_radius;    // r, m (n_grains)
+  std::vector<double> grain_mass;      // m, kg (n_grains)
+  std::vector<int> grain_material;     // material index (n_grains)
+  std::vector<uint8_t> grain_fixed;    // 1 = glued in place (infinite mass) (n_grains)
+  std::vector<double> grain_inv_mass;     // 1/m, 1/kg; 0 for fixed grains (n_grains)
+  std::vector<double> grain_inv_inertia;  // 1/I, 1/(kg m^2); 0 for fixed grains (n_grains)
+
+  // --- materials and the pair-law table ---
+  ContactModel contact_model = ContactModel::Linear;
+  std::vector<Material> materials;     // grain and wall materials
+  std::vector<PairLaw> pair_law;       // (n_materials x n_materials), symmetric
+  int n_materials() const { return static_cast<int>(materials.size()); }
+  const PairLaw& law(int a, int b) const { return pair_law[a * materials.size() + b]; }
+
+  // --- environment ---
+  std::vector<Wall> walls;
+  Vec3 gravity = Vec3(0, 0, -9.81);    // m/s^2
+
+  // --- integration ---
+  double dt = 1e-5;                    // s
+  double kn = 0;                       // scene normal stiffness of the linear law, N/m
+  double skin = 0;                     // neighbour-list skin, m (<= 0: chosen by finalize_model)
+  int partitions = 4;                  // fixed work partitions of the force pass: results are
+                                       // bit-identical for any thread count <= partitions
+  int parallel_min_grains = 3000;      // smaller scenes run on one thread (same result)
+  bool any_resistance = false;         // some pair type has rolling or twisting resistance
+  Guards guards;
+
+  double max_radius = 0, min_radius = 0;  // extreme grain radii, m
+};
+
+// Append a grain (radius r, material index) to the model; returns its id.
+int add_grain(Model& m, double radius, int material, bool fixed = false);
+
+// Derive masses, inverse masses, the pair-law table, radius extremes and the
+// default skin. Call once after materials, grains, walls, kn and dt are set.
+// Throws InputError on inconsistent parameters.
+void finalize_model(Model& m);
+
+// pkdgrav stiffness rule k_n = m_p (v_max / x_max)^2 (MODEL.md §4).
+double kn_rule(double grain_mass, double v_max, double x_max);
+// Time step dt = pi sqrt(m_p / (2 k_n)) / N.
+double dt_rule(double grain_mass, double kn, double steps_per_contact);
+// Duration of an isolated linear contact, sqrt(m* (pi^2 + ln^2 eps) / k_n).
+double linear_contact_time(double mstar, double kn, double eps_n);
+// Damping coefficient of the linear law: C = coef * sqrt(m*), coef = -2 ln eps sqrt(k/(pi^2+ln^2 eps)).
+double linear_damping_coef(double k, double eps);
+// Hertz contact duration for an elastic impact at speed v (2.868 (m*^2/(R E*^2 v))^(1/5)).
+double hertz_contact_time(double mstar, double reff, double e_star, double v);
+
+// Steps per contact of every live pair type (MODEL.md §4).
+struct PairResolution {
+  std::string label;      // e.g. "grain-grain (moderate, smallest grains)"
+  double contact_time;    // s
+  double steps;           // contact_time / dt
+};
+std::vector<PairResolution> pair_resolution(const Model& m, double v_ref);
+
+}  // namespace rt

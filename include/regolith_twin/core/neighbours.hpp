@@ -1,0 +1,17 @@
+// Neighbours stage: cell lists rebuilt when a grain has moved half a skin,
+// giving the half pair list and the grain–wall list with carried-over history.
+#pragma once
+
+#include "regolith_twin/core/state.hpp"
+
+namespace rt {
+
+// True when some grain moved more than half the skin since the last build.
+bool lists_need_rebuild(const Model& m, const State& s);
+
+// Rebuild pair and wall lists from the current positions, keeping the spring
+// history of every pair present in both the old and the new list, and the
+// fixed partition of the rows used by the force pass.
+void build_neighbour_lists(const Model& m, State& s);
+
+}  // namespace rt

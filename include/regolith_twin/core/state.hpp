@@ -1,0 +1,93 @@
+// Evolving state of a DEM scene: grain kinematics, accumulated forces, the
+// neighbour list with its per-contact spring history, and run counters.
+// Everything is stored as separate dense arrays indexed by grain id
+// (structure of arrays). Buffers are sized once by init_state(); the step
+// itself never allocates, except when a neighbour list outgrows its reserve.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "regolith_twin/core/model.hpp"
+
+namespace rt {
+
+// Half neighbour list in CSR form: row i holds partners j > i within
+// r_i + r_j + skin, sorted by j. Contact history lives beside each entry, so
+// it persists for as long as the pair stays in the list.
+struct PairList {
+  std::vector<int> row_start;   // first entry of row i (n_grains + 1)
+  std::vector<int> partner;     // j of each entry
+  std::vector<Vec3> spring_t;   // tangential spring S, m (oriented from i to j)
+  std::vector<Vec3> spring_r;   // rolling spring delta_R, rad
+  std::vector<double> spring_w; // twisting spring delta_T along n, rad
+  std::vector<uint8_t> touching; // 1 while the pair overlaps (its springs are live)
+  int size() const { return static_cast<int>(partner.size()); }
+};
+
+// Grain–wall candidates within r_i + skin, sorted by (grain, wall), with history.
+struct WallList {
+  std::vector<int> grain;       // grain index of each entry
+  std::vector<int> wall;        // wall index of each entry
+  std::vector<Vec3> spring_t;   // tangential spring, m
+  std::vector<Vec3> spring_r;   // rolling spring, rad
+  std::vector<double> spring_w; // twisting spring, rad
+  std::vector<uint8_t> touching; // 1 while the grain overlaps the wall
+  int size() const { return static_cast<int>(grain.size()); }
+};
+
+// Per-thread accumulators of one force pass (merged in thread order).
+struct ThreadScratch {
+  std::vector<Vec3> force;      // force on grains, N (thread 0 writes State::force)
+  std::vector<Vec3> torque;     // torque, N m
+  int touched_lo = 0, touched_hi = 0;  // index range written by this partition
+  double max_overlap_ratio = 0;
+  int max_overlap_grain = -1;
+  long contacts = 0;
+};
+
+struct StepStats {
+  double max_overlap_ratio = 0;  // max over contacts of overlap / smaller radius
+  int max_overlap_grain = -1;    // a grain of the contact with that overlap
+  long contacts = 0;             // grain–grain contacts with overlap > 0
+  long wall_contacts = 0;        // grain–wall contacts with overlap > 0
+  bool finite = true;            // every velocity finite after the last kick
+  double max_disp2 = 0;          // squared max displacement since the last list build, m^2
+};
+
+struct State {
+  double time = 0;              // simulated time, s
+  long step = 0;                // steps taken
+
+  std::vector<Vec3> pos;        // grain centre, m (n_grains)
+  std::vector<Vec3> vel;        // velocity, m/s
+  std::vector<Vec3> omega;      // angular velocity, rad/s
+  std::vector<Vec3> force;      // total force of the last force pass, N
+  std::vector<Vec3> torque;     // total torque of the last force pass, N m
+
+  // Neighbour bookkeeping.
+  PairList pairs;
+  WallList wall_pairs;
+  std::vector<Vec3> pos_at_build;  // positions when the lists were last built
+  long rebuilds = 0;
+  bool lists_valid = false;
+  bool forces_valid = false;
+
+  // Thread partition of the pair rows, fixed between rebuilds (deterministic).
+  std::vector<int> thread_row_begin;  // (n_threads + 1)
+  std::vector<int> thread_wall_begin; // (n_threads + 1) entry split at grain boundaries
+  std::vector<ThreadScratch> scratch;
+
+  // Cell-list scratch (reused by every rebuild).
+  std::vector<int> cell_start, cell_items, cell_of;
+  PairList pairs_next;              // double buffer for rebuilds
+  WallList wall_pairs_next;
+
+  StepStats stats;
+};
+
+// A state for model m: zero kinematics (callers set pos, vel, omega), every
+// buffer sized, lists built at the first step.
+State make_state(const Model& m);
+
+}  // namespace rt

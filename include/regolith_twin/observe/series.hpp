@@ -1,0 +1,44 @@
+// Output files of a run: a CSV time series flushed row by row (so a run that
+// stops early leaves a readable file) and a small JSON object writer.
+#pragma once
+
+#include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace rt {
+
+class CsvSeries {
+ public:
+  CsvSeries() = default;
+  CsvSeries(const CsvSeries&) = delete;
+  CsvSeries& operator=(const CsvSeries&) = delete;
+  ~CsvSeries();
+  // Create the file and write the header line. Throws InputError if it cannot.
+  void open(const std::string& path, const std::vector<std::string>& columns);
+  void row(const std::vector<double>& values);  // one line, flushed
+  void close();
+
+ private:
+  std::FILE* f_ = nullptr;
+  size_t columns_ = 0;
+};
+
+// Flat JSON object: keys in insertion order, numbers, strings, nested objects.
+class JsonObject {
+ public:
+  JsonObject& num(const std::string& key, double v);
+  JsonObject& str(const std::string& key, const std::string& v);
+  JsonObject& boolean(const std::string& key, bool v);
+  JsonObject& obj(const std::string& key, const JsonObject& v);
+  JsonObject& nums(const std::string& key, const std::vector<double>& v);
+  std::string dump(int indent = 0) const;
+  // Write to path atomically (temporary file, then rename).
+  void write(const std::string& path) const;
+
+ private:
+  std::vector<std::pair<std::string, std::string>> items_;  // key, encoded value
+};
+
+}  // namespace rt

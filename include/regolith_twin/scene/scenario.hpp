@@ -1,0 +1,62 @@
+// Scenario files: a YAML description of materials, walls, grain groups, run
+// stages and outputs, turned into a Model and an initial State. Every error
+// names the file, the key and the allowed range.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "regolith_twin/core/model.hpp"
+#include "regolith_twin/core/state.hpp"
+
+namespace YAML {
+class Node;
+}
+
+namespace rt {
+
+// A named, contiguous range of grain ids created by one `grains` entry.
+struct GrainGroup {
+  std::string name;
+  int first = 0;   // first grain id
+  int count = 0;   // number of grains
+};
+
+// One phase of a run.
+struct Stage {
+  std::string name;
+  double duration = 0;                // s of simulated time (maximum)
+  std::vector<std::string> hold;      // groups held in place during the stage
+  double until_rms_speed = -1;        // end early once RMS grain speed is below this, m/s (<0: off)
+  double until_max_speed = -1;        // ... and the max grain speed below this, m/s (<0: off)
+  double check_every = 0.01;          // s between checks of the criteria
+};
+
+struct Scenario {
+  std::string file;                   // path it was read from ("<string>" when parsed from text)
+  std::string name;
+  uint64_t seed = 1;
+  Model model;
+  State initial;
+  std::vector<GrainGroup> groups;
+  std::vector<Stage> stages;
+  double output_every = 0.01;         // s of simulated time between time-series rows
+  double v_ref = 1.0;                 // reference impact speed for resolution reports, m/s
+  std::vector<PairResolution> resolution;  // steps per contact of every pair type
+  std::vector<std::string> warnings;  // non-fatal remarks (under-resolved contacts, ...)
+  const GrainGroup* group(const std::string& name) const;
+};
+
+// Read a scenario file. `overrides` are "dotted.key=yaml-value" strings applied
+// to the document before it is interpreted (command-line --set).
+Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// Interpret an already parsed document; `source` names it in error messages.
+Scenario parse_scenario(const YAML::Node& root, const std::string& source);
+Scenario parse_scenario_text(const std::string& yaml_text, const std::string& source = "<string>");
+
+// Published materials (MODEL.md §9): gravel, moderate, glass_beads, glass_beads_b.
+bool material_preset(const std::string& name, Material& out);
+
+}  // namespace rt

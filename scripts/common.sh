@@ -1,0 +1,46 @@
+# Shared by scripts/run, test, bench, validate: install what is missing, build.
+# Source it; it defines ROOT, BUILD, BIN and the functions below.
+set -euo pipefail
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+BUILD=${REGOLITH_BUILD:-$ROOT/build}
+BIN=$BUILD/devel/lib/regolith_twin
+# ROS and catkin tools run with the system interpreter, not a pyenv one.
+export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
+
+# Debian packages the build and tests need.
+BUILD_PACKAGES=(g++ make cmake catkin libeigen3-dev libyaml-cpp-dev googletest python3)
+# Extra packages for reports (plots).
+REPORT_PACKAGES=(python3-numpy python3-matplotlib)
+
+_apt_updated=0
+need_packages() {
+  local missing=() p
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  local sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo=sudo
+  echo "regolith_twin: installing ${missing[*]}" >&2
+  if [ $_apt_updated -eq 0 ]; then
+    $sudo apt-get update -qq
+    _apt_updated=1
+  fi
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+# Configure and build everything (library, tools, tests) out of source.
+build_all() {
+  need_packages "${BUILD_PACKAGES[@]}"
+  local jobs
+  mkdir -p "$BUILD"
+  jobs=$(nproc 2>/dev/null || echo 2)
+  cmake -S "$ROOT" -B "$BUILD" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release >"$BUILD/configure.log" 2>&1 ||
+    { cat "$BUILD/configure.log" >&2; return 1; }
+  echo "regolith_twin: building in $BUILD ..." >&2
+  if ! make -C "$BUILD" -j"$jobs" --no-print-directory all tests >"$BUILD/make.log" 2>&1; then
+    grep -E -A3 "error|Error" "$BUILD/make.log" | head -60 >&2
+    echo "regolith_twin: build failed (full log: $BUILD/make.log)" >&2
+    return 1
+  fi
+}

@@ -1,0 +1,61 @@
+// Energy bookkeeping from a state (not part of the step; called by observers).
+#include "regolith_twin/core/energy.hpp"
+
+#include <cmath>
+
+#include "regolith_twin/core/contact_law.hpp"
+#include "regolith_twin/core/walls.hpp"
+
+namespace rt {
+namespace {
+
+template <ContactModel M>
+double elastic_energy(const Model& m, const State& s) {
+  double e = 0;
+  const PairList& pl = s.pairs;
+  for (int i = 0; i + 1 < static_cast<int>(pl.row_start.size()); ++i)
+    for (int k = pl.row_start[i]; k < pl.row_start[i + 1]; ++k) {
+      const int j = pl.partner[k];
+      const double rs = m.grain_radius[i] + m.grain_radius[j];
+      const double x = rs - (s.pos[j] - s.pos[i]).norm();
+      if (x <= 0) continue;
+      const double reff = m.grain_radius[i] * m.grain_radius[j] / rs;
+      e += pair_elastic_energy<M>(m.law(m.grain_material[i], m.grain_material[j]), x, reff, pl.spring_t[k],
+                                  pl.spring_r[k], pl.spring_w[k]);
+    }
+  const WallList& wl = s.wall_pairs;
+  for (int k = 0; k < wl.size(); ++k) {
+    const int i = wl.grain[k];
+    const Wall& w = m.walls[wl.wall[k]];
+    const double x = wall_gap(w, s.pos[i], m.grain_radius[i]).overlap;
+    if (x <= 0) continue;
+    e += pair_elastic_energy<M>(m.law(m.grain_material[i], w.law_material), x, m.grain_radius[i], wl.spring_t[k],
+                                wl.spring_r[k], wl.spring_w[k]);
+  }
+  return e;
+}
+
+}  // namespace
+
+Energy energy(const Model& m, const State& s) {
+  Energy e;
+  for (int i = 0; i < m.n_grains; ++i) {
+    if (m.grain_inv_mass[i] == 0) continue;
+    const double mass = m.grain_mass[i];
+    e.translational += 0.5 * mass * s.vel[i].squaredNorm();
+    e.rotational += 0.5 * (1.0 / m.grain_inv_inertia[i]) * s.omega[i].squaredNorm();
+    e.potential -= mass * m.gravity.dot(s.pos[i]);
+  }
+  if (s.lists_valid)
+    e.elastic = m.contact_model == ContactModel::Linear ? elastic_energy<ContactModel::Linear>(m, s)
+                                                        : elastic_energy<ContactModel::HertzMindlin>(m, s);
+  return e;
+}
+
+double coordination_number(const Model& m, const State& s) {
+  long free_grains = 0;
+  for (int i = 0; i < m.n_grains; ++i) free_grains += m.grain_inv_mass[i] != 0;
+  return free_grains ? 2.0 * double(s.stats.contacts) / double(free_grains) : 0.0;
+}
+
+}  // namespace rt

@@ -1,0 +1,206 @@
+// Contacts and forces stage. Each fixed partition of the pair rows writes its
+// own force buffer (partition 0 writes State::force directly); buffers are
+// merged in partition order, then wall contacts are added grain by grain.
+#include "regolith_twin/core/forces.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "regolith_twin/core/contact_law.hpp"
+#include "regolith_twin/core/walls.hpp"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace rt {
+namespace {
+
+int thread_id() {
+#ifdef _OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+int thread_count() {
+#ifdef _OPENMP
+  return omp_get_num_threads();
+#else
+  return 1;
+#endif
+}
+
+// Grain–grain contacts of rows [rb, re) into F, T.
+template <ContactModel M, bool Resist>
+void pair_rows(const Model& m, State& s, int rb, int re, Vec3* F, Vec3* T, ThreadScratch& sc) {
+  PairList& pl = s.pairs;
+  const double dt = m.dt;
+  const int nm = m.n_materials();
+  for (int i = rb; i < re; ++i) {
+    const Vec3 xi = s.pos[i];
+    const double ri = m.grain_radius[i];
+    const double inv_mi = m.grain_inv_mass[i];
+    const int mat_i = m.grain_material[i];
+    for (int k = pl.row_start[i]; k < pl.row_start[i + 1]; ++k) {
+      const int j = pl.partner[k];
+      const Vec3 d = s.pos[j] - xi;
+      const double rj = m.grain_radius[j];
+      const double rs = ri + rj;
+      const double dist2 = d.squaredNorm();
+      if (dist2 >= rs * rs) {
+        if (pl.touching[k]) {  // contact ended: its history goes
+          pl.touching[k] = 0;
+          pl.spring_t[k].setZero();
+          pl.spring_r[k].setZero();
+          pl.spring_w[k] = 0;
+        }
+        continue;
+      }
+      pl.touching[k] = 1;
+      const double dist = std::sqrt(dist2);
+      PairInput in;
+      in.n = d / dist;
+      in.x = rs - dist;
+      in.li = ri - 0.5 * in.x;
+      in.lj = rj - 0.5 * in.x;
+      in.reff = ri * rj / rs;
+      in.mstar = 1.0 / (inv_mi + m.grain_inv_mass[j]);
+      in.vrel = s.vel[j] - s.vel[i];
+      in.wi = s.omega[i];
+      in.wj = s.omega[j];
+      const PairLaw& law = m.pair_law[mat_i * nm + m.grain_material[j]];
+      const PairOutput out =
+          pair_contact<M, Resist>(law, in, PairSprings{pl.spring_t[k], pl.spring_r[k], pl.spring_w[k]}, dt);
+      F[i] += out.force_i;
+      F[j] -= out.force_i;
+      T[i] += out.torque_i;
+      T[j] += out.torque_j;
+      ++sc.contacts;
+      const double ratio = in.x / std::min(ri, rj);
+      if (ratio > sc.max_overlap_ratio) {
+        sc.max_overlap_ratio = ratio;
+        sc.max_overlap_grain = i;
+      }
+    }
+  }
+}
+
+// Grain–wall contacts of wall-list entries [kb, ke) into State::force.
+template <ContactModel M, bool Resist>
+void wall_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
+  WallList& wl = s.wall_pairs;
+  const double dt = m.dt;
+  for (int k = kb; k < ke; ++k) {
+    const int i = wl.grain[k];
+    const Wall& w = m.walls[wl.wall[k]];
+    const double ri = m.grain_radius[i];
+    const WallGap gap = wall_gap(w, s.pos[i], ri);
+    if (gap.overlap <= 0) {
+      if (wl.touching[k]) {
+        wl.touching[k] = 0;
+        wl.spring_t[k].setZero();
+        wl.spring_r[k].setZero();
+        wl.spring_w[k] = 0;
+      }
+      continue;
+    }
+    wl.touching[k] = 1;
+    PairInput in;
+    in.n = gap.n;
+    in.x = gap.overlap;
+    in.li = ri - 0.5 * in.x;
+    in.lj = 0;
+    in.reff = ri;
+    in.mstar = m.grain_mass[i];
+    in.vrel = -s.vel[i];
+    in.wi = s.omega[i];
+    in.wj.setZero();
+    const PairLaw& law = m.law(m.grain_material[i], w.law_material);
+    const PairOutput out =
+        pair_contact<M, Resist>(law, in, PairSprings{wl.spring_t[k], wl.spring_r[k], wl.spring_w[k]}, dt);
+    s.force[i] += out.force_i;
+    s.torque[i] += out.torque_i;
+    ++sc.contacts;
+    const double ratio = in.x / ri;
+    if (ratio > sc.max_overlap_ratio) {
+      sc.max_overlap_ratio = ratio;
+      sc.max_overlap_grain = i;
+    }
+  }
+}
+
+template <ContactModel M, bool Resist>
+void force_pass(const Model& m, State& s) {
+  const int P = m.partitions;
+  const int n = m.n_grains;
+  for (auto& sc : s.scratch) {
+    sc.contacts = 0;
+    sc.max_overlap_ratio = 0;
+    sc.max_overlap_grain = -1;
+  }
+  long wall_contacts = 0;
+#pragma omp parallel if (n >= m.parallel_min_grains)
+  {
+    const int tid = thread_id(), nt = thread_count();
+    // Grain–grain contacts, one partition at a time per thread.
+    for (int p = tid; p < P; p += nt) {
+      ThreadScratch& sc = s.scratch[p];
+      Vec3* F = p == 0 ? s.force.data() : sc.force.data();
+      Vec3* T = p == 0 ? s.torque.data() : sc.torque.data();
+      const int lo = p == 0 ? 0 : sc.touched_lo, hi = p == 0 ? n : sc.touched_hi;
+      std::fill(F + lo, F + hi, Vec3::Zero());
+      std::fill(T + lo, T + hi, Vec3::Zero());
+      pair_rows<M, Resist>(m, s, s.thread_row_begin[p], s.thread_row_begin[p + 1], F, T, sc);
+    }
+#pragma omp barrier
+    // Merge partition buffers in partition order.
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      for (int p = 1; p < P; ++p) {
+        const ThreadScratch& sc = s.scratch[p];
+        if (i >= sc.touched_lo && i < sc.touched_hi) {
+          s.force[i] += sc.force[i];
+          s.torque[i] += sc.torque[i];
+        }
+      }
+    }
+    // Wall contacts: partitions split at grain boundaries, so no two write one grain.
+    // Contact counts of walls go to a separate total.
+    for (int p = tid; p < P; p += nt) {
+      ThreadScratch& sc = s.scratch[p];
+      const long before = sc.contacts;
+      wall_entries<M, Resist>(m, s, s.thread_wall_begin[p], s.thread_wall_begin[p + 1], sc);
+#pragma omp atomic
+      wall_contacts += sc.contacts - before;
+    }
+  }
+  StepStats& st = s.stats;
+  st.contacts = 0;
+  st.max_overlap_ratio = 0;
+  st.max_overlap_grain = -1;
+  for (const auto& sc : s.scratch) {
+    st.contacts += sc.contacts;
+    if (sc.max_overlap_ratio > st.max_overlap_ratio) {
+      st.max_overlap_ratio = sc.max_overlap_ratio;
+      st.max_overlap_grain = sc.max_overlap_grain;
+    }
+  }
+  st.wall_contacts = wall_contacts;
+  st.contacts -= wall_contacts;
+}
+
+}  // namespace
+
+void compute_forces(const Model& m, State& s) {
+  const bool resist = m.any_resistance;
+  if (m.contact_model == ContactModel::Linear) {
+    resist ? force_pass<ContactModel::Linear, true>(m, s) : force_pass<ContactModel::Linear, false>(m, s);
+  } else {
+    resist ? force_pass<ContactModel::HertzMindlin, true>(m, s)
+           : force_pass<ContactModel::HertzMindlin, false>(m, s);
+  }
+  s.forces_valid = true;
+}
+
+}  // namespace rt

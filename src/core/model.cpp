@@ -1,0 +1,200 @@
+// Model construction: masses, the pair-law table, stiffness and time-step rules.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "regolith_twin/core/model.hpp"
+
+namespace rt {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double ln2_pi2(double eps) {
+  const double l = std::log(eps);
+  return l * l + kPi * kPi;
+}
+
+void check_material(const Material& mat) {
+  auto bad = [&](const char* key, const char* range) {
+    std::ostringstream os;
+    os << "material '" << mat.name << "': " << key << " out of range (allowed " << range << ")";
+    throw InputError(os.str());
+  };
+  if (!(mat.eps_n > 0 && mat.eps_n <= 1)) bad("eps_n", "0 < eps_n <= 1");
+  if (!(mat.eps_t > 0 && mat.eps_t <= 1)) bad("eps_t", "0 < eps_t <= 1");
+  if (!(mat.mu_s >= 0)) bad("mu_s", ">= 0");
+  if (!(mat.mu_r >= 0)) bad("mu_r", ">= 0");
+  if (!(mat.mu_t >= 0)) bad("mu_t", ">= 0");
+  if (!(mat.beta >= 0)) bad("beta", ">= 0");
+  if (!(mat.density > 0)) bad("density", "> 0");
+  if (!(mat.kt_over_kn > 0)) bad("kt_over_kn", "> 0");
+  if (!(mat.poisson > -1 && mat.poisson < 0.5)) bad("poisson", "-1 < poisson < 0.5");
+}
+
+// Law constants for a pair of materials a and b (MODEL.md §2–3).
+PairLaw make_law(const Model& m, const Material& a, const Material& b) {
+  // Restitution: a structure material imposes its own; grains average.
+  double eps_n, eps_t;
+  if (a.structure != b.structure) {
+    const Material& s = a.structure ? a : b;
+    eps_n = s.eps_n;
+    eps_t = s.eps_t;
+  } else {
+    eps_n = 0.5 * (a.eps_n + b.eps_n);
+    eps_t = 0.5 * (a.eps_t + b.eps_t);
+  }
+  // Friction: the grain's, unless a structure material brings its own.
+  const Material* fa = &a;
+  const Material* fb = &b;
+  if (a.structure && !a.own_friction && !b.structure) fa = &b;
+  if (b.structure && !b.own_friction && !a.structure) fb = &a;
+  PairLaw L;
+  L.eps_n = eps_n;
+  L.eps_t = eps_t;
+  L.mu_s = 0.5 * (fa->mu_s + fb->mu_s);
+  L.mu_r = 0.5 * (fa->mu_r + fb->mu_r);
+  L.mu_t = 0.5 * (fa->mu_t + fb->mu_t);
+  L.beta = 0.5 * (fa->beta + fb->beta);
+  L.rolling = L.mu_r > 0 && L.beta > 0;
+  L.twisting = L.mu_t > 0 && L.beta > 0 && L.mu_s > 0;
+
+  // Linear law.
+  L.kn = m.kn;
+  L.kt = 0.5 * (a.kt_over_kn + b.kt_over_kn) * m.kn;
+  L.cn_coef = linear_damping_coef(L.kn, eps_n);
+  const double ct_ratio = std::max(a.ct_over_cn, b.ct_over_cn);
+  L.ct_coef = ct_ratio > 0 ? ct_ratio * L.cn_coef : linear_damping_coef(L.kt, eps_t);
+
+  // Hertz–Mindlin: a zero Young's modulus is a rigid partner.
+  auto inv_e = [](const Material& x) { return x.young > 0 ? (1 - x.poisson * x.poisson) / x.young : 0.0; };
+  auto inv_g = [](const Material& x) {
+    return x.young > 0 ? (2 - x.poisson) / (x.young / (2 * (1 + x.poisson))) : 0.0;
+  };
+  const double ie = inv_e(a) + inv_e(b), ig = inv_g(a) + inv_g(b);
+  L.e_star = ie > 0 ? 1 / ie : 0;
+  L.g_star = ig > 0 ? 1 / ig : 0;
+  L.hm_damp = 2 * std::sqrt(5.0 / 6.0) * std::fabs(std::log(eps_n)) / std::sqrt(ln2_pi2(eps_n));
+  return L;
+}
+
+}  // namespace
+
+double kn_rule(double grain_mass, double v_max, double x_max) {
+  const double r = v_max / x_max;
+  return grain_mass * r * r;
+}
+
+double dt_rule(double grain_mass, double kn, double steps_per_contact) {
+  return kPi * std::sqrt(grain_mass / (2 * kn)) / steps_per_contact;
+}
+
+double linear_contact_time(double mstar, double kn, double eps_n) {
+  return std::sqrt(mstar * ln2_pi2(eps_n) / kn);
+}
+
+double linear_damping_coef(double k, double eps) {
+  if (eps >= 1.0) return 0.0;
+  return -2.0 * std::log(eps) * std::sqrt(k / ln2_pi2(eps));
+}
+
+double hertz_contact_time(double mstar, double reff, double e_star, double v) {
+  return 2.8682 * std::pow(mstar * mstar / (reff * e_star * e_star * v), 0.2);
+}
+
+int add_grain(Model& m, double radius, int material, bool fixed) {
+  m.grain_radius.push_back(radius);
+  m.grain_material.push_back(material);
+  m.grain_fixed.push_back(fixed ? 1 : 0);
+  return m.n_grains++;
+}
+
+void finalize_model(Model& m) {
+  const int nm = m.n_materials();
+  if (nm == 0) throw InputError("model: no materials defined");
+  for (const auto& mat : m.materials) check_material(mat);
+  if (m.contact_model == ContactModel::Linear && !(m.kn > 0))
+    throw InputError("model: contact.kn must be > 0 for the linear law");
+  if (!(m.dt > 0)) throw InputError("model: dt must be > 0");
+  if (m.partitions < 1 || m.partitions > 256) throw InputError("model: partitions must be in [1, 256]");
+
+  const int n = m.n_grains;
+  m.grain_mass.assign(n, 0);
+  m.grain_inv_mass.assign(n, 0);
+  m.grain_inv_inertia.assign(n, 0);
+  m.max_radius = 0;
+  m.min_radius = n ? 1e300 : 0;
+  for (int i = 0; i < n; ++i) {
+    const double r = m.grain_radius[i];
+    const int mat = m.grain_material[i];
+    if (!(r > 0)) throw InputError("model: grain " + std::to_string(i) + " has radius <= 0");
+    if (mat < 0 || mat >= nm) throw InputError("model: grain " + std::to_string(i) + " has an unknown material");
+    const double mass = 4.0 / 3.0 * kPi * r * r * r * m.materials[mat].density;
+    m.grain_mass[i] = mass;
+    if (!m.grain_fixed[i]) {
+      m.grain_inv_mass[i] = 1.0 / mass;
+      m.grain_inv_inertia[i] = 1.0 / (0.4 * mass * r * r);
+    }
+    m.max_radius = std::max(m.max_radius, r);
+    m.min_radius = std::min(m.min_radius, r);
+  }
+  for (const auto& w : m.walls)
+    if (w.law_material < 0 || w.law_material >= nm) throw InputError("model: wall '" + w.name + "' has an unknown material");
+
+  m.pair_law.assign(static_cast<size_t>(nm) * nm, PairLaw{});
+  m.any_resistance = false;
+  for (int a = 0; a < nm; ++a)
+    for (int b = 0; b < nm; ++b) {
+      PairLaw L = make_law(m, m.materials[a], m.materials[b]);
+      if (m.contact_model == ContactModel::HertzMindlin && !(L.e_star > 0))
+        throw InputError("model: Hertz–Mindlin needs young > 0 for material '" + m.materials[a].name + "' or '" +
+                         m.materials[b].name + "'");
+      m.any_resistance = m.any_resistance || L.rolling || L.twisting;
+      m.pair_law[a * nm + b] = L;
+    }
+  if (m.skin <= 0) m.skin = 0.5 * m.max_radius;
+}
+
+std::vector<PairResolution> pair_resolution(const Model& m, double v_ref) {
+  std::vector<PairResolution> out;
+  if (m.n_grains == 0) return out;
+  // Smallest grain of each material.
+  const int nm = m.n_materials();
+  std::vector<double> mmin(nm, 0), rmin(nm, 0);
+  for (int i = 0; i < m.n_grains; ++i) {
+    const int a = m.grain_material[i];
+    if (mmin[a] == 0 || m.grain_mass[i] < mmin[a]) {
+      mmin[a] = m.grain_mass[i];
+      rmin[a] = m.grain_radius[i];
+    }
+  }
+  auto time_of = [&](const PairLaw& L, double mstar, double reff, double eps) {
+    if (m.contact_model == ContactModel::Linear) return linear_contact_time(mstar, L.kn, eps);
+    return hertz_contact_time(mstar, reff, L.e_star, v_ref);
+  };
+  for (int a = 0; a < nm; ++a) {
+    if (mmin[a] == 0) continue;
+    for (int b = a; b < nm; ++b) {
+      if (mmin[b] == 0) continue;
+      const double ms = mmin[a] * mmin[b] / (mmin[a] + mmin[b]);
+      const double re = rmin[a] * rmin[b] / (rmin[a] + rmin[b]);
+      const double tc = time_of(m.law(a, b), ms, re, m.law(a, b).eps_n);
+      out.push_back({"grain-grain (" + m.materials[a].name + "/" + m.materials[b].name + ")", tc, tc / m.dt});
+    }
+  }
+  std::vector<bool> seen(nm, false);
+  for (const auto& w : m.walls) {
+    if (seen[w.law_material]) continue;
+    seen[w.law_material] = true;
+    for (int a = 0; a < nm; ++a) {
+      if (mmin[a] == 0) continue;
+      const PairLaw& L = m.law(a, w.law_material);
+      const double tc = time_of(L, mmin[a], rmin[a], L.eps_n);
+      out.push_back({"grain-wall (" + m.materials[a].name + "/" + m.materials[w.law_material].name + ")", tc,
+                     tc / m.dt});
+    }
+  }
+  return out;
+}
+
+}  // namespace rt

@@ -1,0 +1,219 @@
+// Neighbours stage: counting-sort cell lists, half pair list, wall list,
+// history carry-over and the fixed work partition.
+#include "regolith_twin/core/neighbours.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "regolith_twin/core/walls.hpp"
+
+namespace rt {
+namespace {
+
+// Copy the springs of entries present in both sorted rows; zero the rest.
+template <class List>
+void carry_history(const List& old_list, int os, int oe, const std::vector<int>& old_key, List& nl, int ns,
+                   int ne, const std::vector<int>& new_key) {
+  int o = os;
+  for (int k = ns; k < ne; ++k) {
+    while (o < oe && old_key[o] < new_key[k]) ++o;
+    if (o < oe && old_key[o] == new_key[k]) {
+      nl.spring_t[k] = old_list.spring_t[o];
+      nl.spring_r[k] = old_list.spring_r[o];
+      nl.spring_w[k] = old_list.spring_w[o];
+      nl.touching[k] = old_list.touching[o];
+    } else {
+      nl.spring_t[k].setZero();
+      nl.spring_r[k].setZero();
+      nl.spring_w[k] = 0;
+      nl.touching[k] = 0;
+    }
+  }
+}
+
+template <class List>
+void size_history(List& l, int n) {
+  l.spring_t.resize(n);
+  l.spring_r.resize(n);
+  l.spring_w.resize(n);
+  l.touching.resize(n);
+}
+
+// Sort grains into cells of side >= 2 r_max + skin over their bounding box.
+struct Grid {
+  Vec3 lo;
+  double inv_cell;
+  int nx, ny, nz;
+};
+
+Grid bin_grains(const Model& m, State& s) {
+  const int n = m.n_grains;
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (int i = 0; i < n; ++i) {
+    lo = lo.cwiseMin(s.pos[i]);
+    hi = hi.cwiseMax(s.pos[i]);
+  }
+  if (n == 0) lo = hi = Vec3::Zero();
+  double cell = 2 * m.max_radius + m.skin;
+  const long max_cells = std::max<long>(4L * n, 64);
+  Grid g{};
+  for (;;) {
+    const Vec3 ext = (hi - lo) / cell;
+    const double cells = (std::floor(ext.x()) + 1) * (std::floor(ext.y()) + 1) * (std::floor(ext.z()) + 1);
+    if (cells <= max_cells) {
+      g = {lo, 1.0 / cell, int(ext.x()) + 1, int(ext.y()) + 1, int(ext.z()) + 1};
+      break;
+    }
+    cell *= 1.25;  // sparse scene (a grain far away): coarser cells
+  }
+  const int ncell = g.nx * g.ny * g.nz;
+  s.cell_start.assign(ncell + 1, 0);
+  s.cell_of.resize(n);
+  s.cell_items.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const Vec3 c = (s.pos[i] - g.lo) * g.inv_cell;
+    const int cx = std::min(int(c.x()), g.nx - 1), cy = std::min(int(c.y()), g.ny - 1),
+              cz = std::min(int(c.z()), g.nz - 1);
+    const int id = (cz * g.ny + cy) * g.nx + cx;
+    s.cell_of[i] = id;
+    ++s.cell_start[id + 1];
+  }
+  for (int c = 0; c < ncell; ++c) s.cell_start[c + 1] += s.cell_start[c];
+  // Fill in ascending grain order, using cell_start as a moving cursor, then
+  // shift it back so cell_start[c] is again the first slot of cell c.
+  for (int i = 0; i < n; ++i) s.cell_items[s.cell_start[s.cell_of[i]]++] = i;
+  for (int c = ncell; c > 0; --c) s.cell_start[c] = s.cell_start[c - 1];
+  s.cell_start[0] = 0;
+  return g;
+}
+
+void build_pairs(const Model& m, State& s, const Grid& g) {
+  const int n = m.n_grains;
+  PairList& nl = s.pairs_next;
+  nl.row_start.resize(n + 1);
+  nl.partner.clear();
+  const double skin = m.skin;
+  for (int i = 0; i < n; ++i) {
+    nl.row_start[i] = nl.size();
+    const Vec3 xi = s.pos[i];
+    const double ri = m.grain_radius[i];
+    const int c = s.cell_of[i];
+    const int cx = c % g.nx, cy = (c / g.nx) % g.ny, cz = c / (g.nx * g.ny);
+    for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, g.nz - 1); ++z)
+      for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, g.ny - 1); ++y)
+        for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, g.nx - 1); ++x) {
+          const int cc = (z * g.ny + y) * g.nx + x;
+          for (int q = s.cell_start[cc]; q < s.cell_start[cc + 1]; ++q) {
+            const int j = s.cell_items[q];
+            if (j <= i) continue;
+            if (m.grain_fixed[i] && m.grain_fixed[j]) continue;  // glued pairs never interact
+            const double cut = ri + m.grain_radius[j] + skin;
+            if ((s.pos[j] - xi).squaredNorm() < cut * cut) nl.partner.push_back(j);
+          }
+        }
+    std::sort(nl.partner.begin() + nl.row_start[i], nl.partner.end());
+  }
+  nl.row_start[n] = nl.size();
+  size_history(nl, nl.size());
+  const PairList& ol = s.pairs;
+  const bool have_old = s.lists_valid && static_cast<int>(ol.row_start.size()) == n + 1;
+  for (int i = 0; i < n; ++i) {
+    if (have_old)
+      carry_history(ol, ol.row_start[i], ol.row_start[i + 1], ol.partner, nl, nl.row_start[i], nl.row_start[i + 1],
+                    nl.partner);
+    else
+      carry_history(nl, 0, 0, nl.partner, nl, nl.row_start[i], nl.row_start[i + 1], nl.partner);
+  }
+  std::swap(s.pairs, s.pairs_next);
+}
+
+void build_walls(const Model& m, State& s) {
+  WallList& nl = s.wall_pairs_next;
+  nl.grain.clear();
+  nl.wall.clear();
+  const int nw = static_cast<int>(m.walls.size());
+  for (int i = 0; i < m.n_grains; ++i) {
+    if (m.grain_fixed[i]) continue;
+    for (int w = 0; w < nw; ++w) {
+      if (wall_gap(m.walls[w], s.pos[i], m.grain_radius[i]).overlap > -m.skin) {
+        nl.grain.push_back(i);
+        nl.wall.push_back(w);
+      }
+    }
+  }
+  size_history(nl, nl.size());
+  // Entries are sorted by (grain, wall): carry history with a key of grain * nw + wall.
+  const WallList& ol = s.wall_pairs;
+  int o = 0;
+  const int on = s.lists_valid ? ol.size() : 0;
+  for (int k = 0; k < nl.size(); ++k) {
+    const long key = long(nl.grain[k]) * nw + nl.wall[k];
+    while (o < on && long(ol.grain[o]) * nw + ol.wall[o] < key) ++o;
+    if (o < on && long(ol.grain[o]) * nw + ol.wall[o] == key) {
+      nl.spring_t[k] = ol.spring_t[o];
+      nl.spring_r[k] = ol.spring_r[o];
+      nl.spring_w[k] = ol.spring_w[o];
+      nl.touching[k] = ol.touching[o];
+    } else {
+      nl.spring_t[k].setZero();
+      nl.spring_r[k].setZero();
+      nl.spring_w[k] = 0;
+      nl.touching[k] = 0;
+    }
+  }
+  std::swap(s.wall_pairs, s.wall_pairs_next);
+}
+
+// Split rows into partitions of about equal entry counts; record the grain
+// range each partition writes so merging touches only that range.
+void partition_work(const Model& m, State& s) {
+  const int P = m.partitions;
+  const int n = m.n_grains;
+  const PairList& pl = s.pairs;
+  const long total = pl.size();
+  s.thread_row_begin.resize(P + 1);
+  for (int p = 0; p <= P; ++p) {
+    const long target = total * p / P;
+    s.thread_row_begin[p] =
+        p == P ? n : int(std::lower_bound(pl.row_start.begin(), pl.row_start.end() - 1, target) - pl.row_start.begin());
+  }
+  for (int p = 0; p < P; ++p) {
+    ThreadScratch& sc = s.scratch[p];
+    const int rb = s.thread_row_begin[p], re = s.thread_row_begin[p + 1];
+    int hi = re;
+    for (int i = rb; i < re; ++i)
+      if (pl.row_start[i + 1] > pl.row_start[i]) hi = std::max(hi, pl.partner[pl.row_start[i + 1] - 1] + 1);
+    sc.touched_lo = rb;
+    sc.touched_hi = std::min(hi, n);
+  }
+  // Wall entries: equal counts, boundaries moved to grain changes.
+  const WallList& wl = s.wall_pairs;
+  s.thread_wall_begin.resize(P + 1);
+  for (int p = 0; p <= P; ++p) {
+    int k = int(long(wl.size()) * p / P);
+    while (k > 0 && k < wl.size() && wl.grain[k] == wl.grain[k - 1]) ++k;
+    s.thread_wall_begin[p] = k;
+  }
+  for (int p = 1; p <= P; ++p) s.thread_wall_begin[p] = std::max(s.thread_wall_begin[p], s.thread_wall_begin[p - 1]);
+}
+
+}  // namespace
+
+bool lists_need_rebuild(const Model& m, const State& s) {
+  if (!s.lists_valid) return true;
+  const double half = 0.5 * m.skin;
+  return s.stats.max_disp2 > half * half;
+}
+
+void build_neighbour_lists(const Model& m, State& s) {
+  const Grid g = bin_grains(m, s);
+  build_pairs(m, s, g);
+  build_walls(m, s);
+  partition_work(m, s);
+  s.pos_at_build = s.pos;
+  s.stats.max_disp2 = 0;
+  s.lists_valid = true;
+  ++s.rebuilds;
+}
+
+}  // namespace rt

@@ -1,0 +1,44 @@
+// State construction: every buffer the step needs, sized once.
+#include "regolith_twin/core/state.hpp"
+
+namespace rt {
+
+State make_state(const Model& m) {
+  const int n = m.n_grains;
+  State s;
+  s.pos.assign(n, Vec3::Zero());
+  s.vel.assign(n, Vec3::Zero());
+  s.omega.assign(n, Vec3::Zero());
+  s.force.assign(n, Vec3::Zero());
+  s.torque.assign(n, Vec3::Zero());
+  s.pos_at_build.assign(n, Vec3::Zero());
+  s.scratch.resize(m.partitions);
+  for (int p = 1; p < m.partitions; ++p) {
+    s.scratch[p].force.assign(n, Vec3::Zero());
+    s.scratch[p].torque.assign(n, Vec3::Zero());
+  }
+  // Reserve list storage with head room so rebuilds do not allocate.
+  const size_t pair_cap = 16 * size_t(n) + 64, wall_cap = 4 * size_t(n) + 64;
+  for (PairList* l : {&s.pairs, &s.pairs_next}) {
+    l->row_start.reserve(n + 1);
+    l->partner.reserve(pair_cap);
+    l->spring_t.reserve(pair_cap);
+    l->spring_r.reserve(pair_cap);
+    l->spring_w.reserve(pair_cap);
+    l->touching.reserve(pair_cap);
+  }
+  for (WallList* l : {&s.wall_pairs, &s.wall_pairs_next}) {
+    l->grain.reserve(wall_cap);
+    l->wall.reserve(wall_cap);
+    l->spring_t.reserve(wall_cap);
+    l->spring_r.reserve(wall_cap);
+    l->spring_w.reserve(wall_cap);
+    l->touching.reserve(wall_cap);
+  }
+  s.cell_start.reserve(4 * size_t(n) + 66);
+  s.cell_items.reserve(n);
+  s.cell_of.reserve(n);
+  return s;
+}
+
+}  // namespace rt

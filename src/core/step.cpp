@@ -1,0 +1,47 @@
+// The time step: a short pipeline of stages (see step.hpp).
+#include "regolith_twin/core/step.hpp"
+
+#include <sstream>
+
+#include "regolith_twin/core/forces.hpp"
+#include "regolith_twin/core/integrate.hpp"
+#include "regolith_twin/core/neighbours.hpp"
+
+namespace rt {
+
+void prime(const Model& m, State& s) {
+  build_neighbour_lists(m, s);
+  compute_forces(m, s);
+}
+
+void step(const Model& m, State& s) {
+  if (!s.forces_valid) prime(m, s);
+  kick(m, s, 0.5 * m.dt);                                          // integrate: half kick
+  check_guards(m, s);
+  drift(m, s, m.dt);                                               //            drift
+  if (lists_need_rebuild(m, s)) build_neighbour_lists(m, s);       // neighbours
+  compute_forces(m, s);                                            // contacts -> forces
+  kick(m, s, 0.5 * m.dt);                                          // integrate: half kick
+  s.time += m.dt;
+  ++s.step;
+  check_guards(m, s);                                              // guards
+}
+
+void check_guards(const Model& m, const State& s) {
+  const StepStats& st = s.stats;
+  if (!st.finite) {
+    std::ostringstream os;
+    os << "numerical blow-up at step " << s.step << " (t = " << s.time
+       << " s): a grain velocity became NaN or infinite; reduce dt or k_n (see the steps-per-contact report)";
+    throw BlowUpError(os.str());
+  }
+  if (st.max_overlap_ratio > m.guards.max_overlap_ratio) {
+    std::ostringstream os;
+    os << "numerical blow-up at step " << s.step << " (t = " << s.time << " s): overlap of grain "
+       << st.max_overlap_grain << " reached " << st.max_overlap_ratio << " of its radius, beyond the limit "
+       << m.guards.max_overlap_ratio << " (guards.max_overlap_ratio); raise k_n or lower the impact speed";
+    throw BlowUpError(os.str());
+  }
+}
+
+}  // namespace rt

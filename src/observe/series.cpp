@@ -1,0 +1,121 @@
+// CSV series and JSON summary writers.
+#include "regolith_twin/observe/series.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "regolith_twin/core/types.hpp"
+
+namespace rt {
+namespace {
+
+std::string encode_num(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+std::string encode_str(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"': o += "\\\""; break;
+      case '\\': o += "\\\\"; break;
+      case '\n': o += "\\n"; break;
+      case '\t': o += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char b[8];
+          std::snprintf(b, sizeof b, "\\u%04x", c);
+          o += b;
+        } else {
+          o += c;
+        }
+    }
+  }
+  return o + "\"";
+}
+
+}  // namespace
+
+CsvSeries::~CsvSeries() { close(); }
+
+void CsvSeries::open(const std::string& path, const std::vector<std::string>& columns) {
+  close();
+  f_ = std::fopen(path.c_str(), "w");
+  if (!f_) throw InputError(path + ": cannot create output file");
+  columns_ = columns.size();
+  for (size_t i = 0; i < columns.size(); ++i) std::fprintf(f_, "%s%s", i ? "," : "", columns[i].c_str());
+  std::fprintf(f_, "\n");
+  std::fflush(f_);
+}
+
+void CsvSeries::row(const std::vector<double>& values) {
+  if (!f_) return;
+  for (size_t i = 0; i < values.size() && i < columns_; ++i) std::fprintf(f_, "%s%.10g", i ? "," : "", values[i]);
+  std::fprintf(f_, "\n");
+  std::fflush(f_);
+}
+
+void CsvSeries::close() {
+  if (f_) std::fclose(f_);
+  f_ = nullptr;
+}
+
+JsonObject& JsonObject::num(const std::string& k, double v) {
+  items_.emplace_back(k, encode_num(v));
+  return *this;
+}
+JsonObject& JsonObject::str(const std::string& k, const std::string& v) {
+  items_.emplace_back(k, encode_str(v));
+  return *this;
+}
+JsonObject& JsonObject::boolean(const std::string& k, bool v) {
+  items_.emplace_back(k, v ? "true" : "false");
+  return *this;
+}
+JsonObject& JsonObject::obj(const std::string& k, const JsonObject& v) {
+  items_.emplace_back(k, "\x01" + v.dump(0));  // marker: nested, re-indented on dump
+  return *this;
+}
+JsonObject& JsonObject::nums(const std::string& k, const std::vector<double>& v) {
+  std::string s = "[";
+  for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + encode_num(v[i]);
+  items_.emplace_back(k, s + "]");
+  return *this;
+}
+
+std::string JsonObject::dump(int indent) const {
+  const std::string pad(indent + 2, ' '), end_pad(indent, ' ');
+  std::ostringstream os;
+  os << "{\n";
+  for (size_t i = 0; i < items_.size(); ++i) {
+    std::string v = items_[i].second;
+    if (!v.empty() && v[0] == '\x01') {
+      // Nested object: re-indent its lines.
+      std::string inner = v.substr(1), out;
+      for (char c : inner) {
+        out += c;
+        if (c == '\n') out += std::string(indent + 2, ' ');
+      }
+      v = out;
+    }
+    os << pad << encode_str(items_[i].first) << ": " << v << (i + 1 < items_.size() ? "," : "") << "\n";
+  }
+  os << end_pad << "}";
+  return os.str();
+}
+
+void JsonObject::write(const std::string& path) const {
+  const std::string tmp = path + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "w");
+  if (!f) throw InputError(path + ": cannot create output file");
+  const std::string text = dump(0) + "\n";
+  const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path.c_str()) != 0)
+    throw InputError(path + ": could not write output file");
+}
+
+}  // namespace rt

@@ -1,0 +1,569 @@
+// Scenario files: YAML -> Model + initial State, with errors that name the
+// file, the key and the allowed range.
+#include "regolith_twin/scene/scenario.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "regolith_twin/core/walls.hpp"
+#include "regolith_twin/scene/data_file.hpp"
+#include "regolith_twin/scene/generate.hpp"
+
+namespace rt {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Typed access to a YAML mapping with full key paths in every message.
+class Reader {
+ public:
+  explicit Reader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    throw InputError(source_ + ": key '" + key + "': " + what);
+  }
+
+  // map[key], or an undefined node when map itself is absent or not a mapping.
+  static YAML::Node get(const YAML::Node& map, const std::string& key) {
+    if (!map || !map.IsMap()) return YAML::Node(YAML::NodeType::Undefined);
+    return map[key];
+  }
+
+  static std::string join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
+
+  double number(const YAML::Node& node, const std::string& path, double lo, double hi, bool lo_open = false) const {
+    double v = 0;
+    try {
+      v = node.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(path, "expected a number" + range_text(lo, hi, lo_open) + ", got '" + scalar_text(node) + "'");
+    }
+    if (!std::isfinite(v) || (lo_open ? !(v > lo) : !(v >= lo)) || !(v <= hi))
+      fail(path, "value " + scalar_text(node) + " out of range (allowed" + range_text(lo, hi, lo_open) + ")");
+    return v;
+  }
+
+  double number(const YAML::Node& map, const std::string& path, const std::string& key, double dflt, double lo,
+                double hi, bool lo_open = false) const {
+    const YAML::Node n = get(map, key);
+    if (!n) return dflt;
+    return number(n, join(path, key), lo, hi, lo_open);
+  }
+
+  long integer(const YAML::Node& map, const std::string& path, const std::string& key, long dflt, long lo,
+               long hi) const {
+    const YAML::Node n = get(map, key);
+    if (!n) return dflt;
+    long v = 0;
+    try {
+      v = n.as<long>();
+    } catch (const YAML::Exception&) {
+      fail(join(path, key), "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                                "], got '" + scalar_text(n) + "'");
+    }
+    if (v < lo || v > hi)
+      fail(join(path, key), "value " + std::to_string(v) + " out of range (allowed [" + std::to_string(lo) + ", " +
+                                std::to_string(hi) + "])");
+    return v;
+  }
+
+  bool boolean(const YAML::Node& map, const std::string& path, const std::string& key, bool dflt) const {
+    const YAML::Node n = get(map, key);
+    if (!n) return dflt;
+    try {
+      return n.as<bool>();
+    } catch (const YAML::Exception&) {
+      fail(join(path, key), "expected true or false, got '" + scalar_text(n) + "'");
+    }
+  }
+
+  std::string text(const YAML::Node& map, const std::string& path, const std::string& key,
+                   const std::string& dflt) const {
+    const YAML::Node n = get(map, key);
+    if (!n) return dflt;
+    if (!n.IsScalar()) fail(join(path, key), "expected a string");
+    return n.as<std::string>();
+  }
+
+  std::string choice(const YAML::Node& map, const std::string& path, const std::string& key,
+                     const std::string& dflt, const std::vector<std::string>& allowed) const {
+    const std::string v = text(map, path, key, dflt);
+    for (const auto& a : allowed)
+      if (v == a) return v;
+    std::string list;
+    for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+    fail(join(path, key), "'" + v + "' is not one of: " + list);
+  }
+
+  Vec3 vec3(const YAML::Node& map, const std::string& path, const std::string& key, const Vec3& dflt,
+            bool required = false) const {
+    const YAML::Node n = get(map, key);
+    if (!n) {
+      if (required) fail(join(path, key), "missing (expected [x, y, z])");
+      return dflt;
+    }
+    if (!n.IsSequence() || n.size() != 3) fail(join(path, key), "expected a list of three numbers [x, y, z]");
+    Vec3 v;
+    for (int i = 0; i < 3; ++i)
+      v[i] = number(n[i], join(path, key) + "[" + std::to_string(i) + "]", -kInf, kInf);
+    return v;
+  }
+
+  YAML::Node map(const YAML::Node& parent, const std::string& path, const std::string& key, bool required) const {
+    const YAML::Node n = get(parent, key);
+    if (!n) {
+      if (required) fail(join(path, key), "missing");
+      return n;
+    }
+    if (!n.IsMap()) fail(join(path, key), "expected a mapping");
+    return n;
+  }
+
+  // Unknown keys are refused, so typos do not silently fall back to defaults.
+  void only(const YAML::Node& map, const std::string& path, const std::vector<std::string>& keys) const {
+    if (!map || !map.IsMap()) return;
+    for (const auto& kv : map) {
+      const std::string k = kv.first.as<std::string>();
+      bool ok = false;
+      for (const auto& a : keys) ok = ok || a == k;
+      if (!ok) {
+        std::string list;
+        for (const auto& a : keys) list += (list.empty() ? "" : ", ") + a;
+        fail(join(path, k), "unknown key (allowed here: " + list + ")");
+      }
+    }
+  }
+
+  const std::string& source() const { return source_; }
+
+ private:
+  static std::string scalar_text(const YAML::Node& n) {
+    if (n.IsScalar()) return n.Scalar();
+    std::ostringstream os;
+    os << n;
+    return os.str();
+  }
+  static std::string num_text(double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  }
+  static std::string range_text(double lo, double hi, bool lo_open) {
+    if (lo == -kInf && hi == kInf) return "";
+    std::string s = " ";
+    if (hi == kInf) return s + (lo_open ? "> " : ">= ") + num_text(lo);
+    if (lo == -kInf) return s + "<= " + num_text(hi);
+    return s + "in " + (lo_open ? "(" : "[") + num_text(lo) + ", " + num_text(hi) + "]";
+  }
+
+  std::string source_;
+};
+
+// Published materials (MODEL.md §9).
+const std::map<std::string, Material>& presets() {
+  static const std::map<std::string, Material> p = [] {
+    std::map<std::string, Material> m;
+    auto add = [&](const char* name, double density, double en, double et, double ms, double mr, double mt,
+                   double beta) {
+      Material x;
+      x.name = name;
+      x.density = density;
+      x.eps_n = en;
+      x.eps_t = et;
+      x.mu_s = ms;
+      x.mu_r = mr;
+      x.mu_t = mt;
+      x.beta = beta;
+      m[name] = x;
+    };
+    add("gravel", 2430, 0.5, 0.5, 1.0, 1.05, 1.3, 1.0);
+    add("moderate", 2430, 0.5, 0.5, 1.0, 1.05, 1.3, 0.2);
+    add("glass_beads", 2480, 0.9, 1.0, 1.0, 1.05, 1.3, 0.2);
+    add("glass_beads_b", 2480, 0.9, 1.0, 1.0, 2.0, 1.3, 0.1);
+    return m;
+  }();
+  return p;
+}
+
+Material parse_material(const Reader& rd, const YAML::Node& node, const std::string& path, const std::string& name) {
+  rd.only(node, path,
+          {"preset", "density", "eps_n", "eps_t", "mu_s", "mu_r", "mu_t", "beta", "young", "poisson", "kt_over_kn",
+           "ct_over_cn", "structure", "own_friction"});
+  Material m;
+  const std::string preset = rd.text(node, path, "preset", "");
+  if (!preset.empty() && !material_preset(preset, m)) {
+    std::string list;
+    for (const auto& kv : presets()) list += (list.empty() ? "" : ", ") + kv.first;
+    rd.fail(Reader::join(path, "preset"), "unknown material preset '" + preset + "' (known: " + list + ")");
+  }
+  m.name = name;
+  m.density = rd.number(node, path, "density", m.density, 0, 1e6, true);
+  m.eps_n = rd.number(node, path, "eps_n", m.eps_n, 0, 1, true);
+  m.eps_t = rd.number(node, path, "eps_t", m.eps_t, 0, 1, true);
+  m.mu_s = rd.number(node, path, "mu_s", m.mu_s, 0, 100);
+  m.mu_r = rd.number(node, path, "mu_r", m.mu_r, 0, 100);
+  m.mu_t = rd.number(node, path, "mu_t", m.mu_t, 0, 100);
+  m.beta = rd.number(node, path, "beta", m.beta, 0, 10);
+  m.young = rd.number(node, path, "young", m.young, 0, 1e15);
+  m.poisson = rd.number(node, path, "poisson", m.poisson, -0.999, 0.499);
+  m.kt_over_kn = rd.number(node, path, "kt_over_kn", m.kt_over_kn, 0, 10, true);
+  m.ct_over_cn = rd.number(node, path, "ct_over_cn", m.ct_over_cn, -1, 10);
+  m.structure = rd.boolean(node, path, "structure", m.structure);
+  m.own_friction = rd.boolean(node, path, "own_friction", m.own_friction);
+  return m;
+}
+
+int material_index(const Reader& rd, const Model& m, const YAML::Node& map, const std::string& path) {
+  const std::string name = rd.text(map, path, "material", "");
+  if (name.empty()) rd.fail(Reader::join(path, "material"), "missing (name of an entry under 'materials')");
+  for (int i = 0; i < m.n_materials(); ++i)
+    if (m.materials[i].name == name) return i;
+  std::string list;
+  for (const auto& x : m.materials) list += (list.empty() ? "" : ", ") + x.name;
+  rd.fail(Reader::join(path, "material"), "unknown material '" + name + "' (defined: " + list + ")");
+}
+
+Vec3 unit(const Reader& rd, const Vec3& v, const std::string& key) {
+  const double n = v.norm();
+  if (!(n > 0)) rd.fail(key, "must be a non-zero vector");
+  return v / n;
+}
+
+Wall parse_wall(const Reader& rd, const Model& m, const YAML::Node& w, const std::string& path) {
+  rd.only(w, path,
+          {"type", "name", "material", "point", "normal", "center", "base", "axis", "radius", "radius2", "length",
+           "inner", "u", "half_u", "half_v"});
+  Wall out;
+  const std::string type =
+      rd.choice(w, path, "type", "", {"plane", "disk", "cylinder", "cone", "rectangle", "sphere_shell"});
+  out.name = rd.text(w, path, "name", path);
+  out.law_material = material_index(rd, m, w, path);
+  const Vec3 up = Vec3::UnitZ();
+  if (type == "plane") {
+    out.type = WallType::Plane;
+    out.origin = rd.vec3(w, path, "point", Vec3::Zero(), true);
+    out.axis = unit(rd, rd.vec3(w, path, "normal", up, true), Reader::join(path, "normal"));
+  } else if (type == "disk" || type == "rectangle") {
+    out.type = type == "disk" ? WallType::Disk : WallType::Rectangle;
+    out.origin = rd.vec3(w, path, "center", Vec3::Zero(), true);
+    out.axis = unit(rd, rd.vec3(w, path, "normal", up), Reader::join(path, "normal"));
+    if (type == "disk") {
+      out.radius = rd.number(w, path, "radius", 0, 0, kInf, true);
+    } else {
+      Vec3 u = rd.vec3(w, path, "u", out.axis.unitOrthogonal());
+      u -= u.dot(out.axis) * out.axis;
+      out.u = unit(rd, u, Reader::join(path, "u"));
+      out.half_u = rd.number(w, path, "half_u", 0, 0, kInf, true);
+      out.half_v = rd.number(w, path, "half_v", 0, 0, kInf, true);
+    }
+  } else if (type == "cylinder" || type == "cone") {
+    out.type = type == "cylinder" ? WallType::Cylinder : WallType::Cone;
+    out.origin = rd.vec3(w, path, "base", Vec3::Zero(), true);
+    out.axis = unit(rd, rd.vec3(w, path, "axis", up), Reader::join(path, "axis"));
+    out.radius = rd.number(w, path, "radius", 0, 0, kInf, true);
+    out.radius2 = type == "cone" ? rd.number(w, path, "radius2", 0, 0, kInf) : out.radius;
+    out.length = rd.number(w, path, "length", type == "cone" ? 1.0 : 0.0, type == "cone" ? 0 : -1, kInf,
+                           type == "cone");
+    out.inner = rd.boolean(w, path, "inner", true);
+  } else {
+    out.type = WallType::SphereShell;
+    out.origin = rd.vec3(w, path, "center", Vec3::Zero(), true);
+    out.radius = rd.number(w, path, "radius", 0, 0, kInf, true);
+    out.inner = rd.boolean(w, path, "inner", true);
+  }
+  return out;
+}
+
+RadiusDist parse_radius(const Reader& rd, const YAML::Node& g, const std::string& path) {
+  RadiusDist d;
+  const YAML::Node r = g["radius"];
+  const std::string key = Reader::join(path, "radius");
+  if (!r) rd.fail(key, "missing (a number, or {mean, sigma, cut})");
+  if (r.IsScalar()) {
+    d.mean = rd.number(r, key, 0, kInf, true);
+    return d;
+  }
+  rd.only(r, key, {"mean", "sigma", "cut"});
+  d.mean = rd.number(r, key, "mean", 0, 0, kInf, true);
+  d.sigma = rd.number(r, key, "sigma", 0, 0, 0.9);
+  d.cut = rd.number(r, key, "cut", 1.0, 0, 5);
+  if (d.sigma * d.cut >= 1) rd.fail(key, "sigma * cut must be < 1 (radii must stay positive)");
+  return d;
+}
+
+Region parse_region(const Reader& rd, const YAML::Node& f, const std::string& path) {
+  Region r;
+  const std::string shape = rd.choice(f, path, "shape", "box", {"box", "cylinder"});
+  if (shape == "box") {
+    r.shape = RegionShape::Box;
+    r.lo = rd.vec3(f, path, "lo", Vec3::Zero(), true);
+    r.hi = rd.vec3(f, path, "hi", Vec3::Zero(), true);
+    if (!((r.hi - r.lo).minCoeff() > 0)) rd.fail(Reader::join(path, "hi"), "every component must exceed lo");
+  } else {
+    r.shape = RegionShape::Cylinder;
+    r.center = rd.vec3(f, path, "center", Vec3::Zero(), true);
+    r.radius = rd.number(f, path, "radius", 0, 0, kInf, true);
+    const YAML::Node z = f["z"];
+    if (!z || !z.IsSequence() || z.size() != 2) rd.fail(Reader::join(path, "z"), "expected [z_min, z_max]");
+    const double z0 = rd.number(z[0], Reader::join(path, "z[0]"), -kInf, kInf);
+    const double z1 = rd.number(z[1], Reader::join(path, "z[1]"), z0, kInf, true);
+    r.lo = Vec3(r.center.x() - r.radius, r.center.y() - r.radius, z0);
+    r.hi = Vec3(r.center.x() + r.radius, r.center.y() + r.radius, z1);
+  }
+  return r;
+}
+
+// One `grains` entry: explicit grain, lattice fill or data file.
+void parse_grains(const Reader& rd, Scenario& sc, const YAML::Node& g, const std::string& path,
+                  std::mt19937_64& rng) {
+  rd.only(g, path, {"name", "material", "radius", "position", "velocity", "omega", "fill", "file", "fixed"});
+  Model& m = sc.model;
+  GrainGroup grp;
+  grp.name = rd.text(g, path, "name", path);
+  grp.first = m.n_grains;
+  const int mat = material_index(rd, m, g, path);
+  const bool fixed = rd.boolean(g, path, "fixed", false);
+  const Vec3 vel = rd.vec3(g, path, "velocity", Vec3::Zero());
+  const Vec3 omg = rd.vec3(g, path, "omega", Vec3::Zero());
+  std::vector<Vec3> pos;
+  std::vector<double> radii;
+  const int modes = int(bool(g["position"])) + int(bool(g["fill"])) + int(bool(g["file"]));
+  if (modes != 1) rd.fail(path, "give exactly one of 'position', 'fill' or 'file'");
+  if (g["position"]) {
+    pos.push_back(rd.vec3(g, path, "position", Vec3::Zero(), true));
+    radii.push_back(parse_radius(rd, g, path).mean);
+  } else if (g["fill"]) {
+    const std::string fp = Reader::join(path, "fill");
+    const YAML::Node f = rd.map(g, path, "fill", true);
+    rd.only(f, fp, {"shape", "lo", "hi", "center", "radius", "z", "count", "spacing", "jitter"});
+    const RadiusDist dist = parse_radius(rd, g, path);
+    const Region region = parse_region(rd, f, fp);
+    const long count = rd.integer(f, fp, "count", 1000, 1, 50000000);
+    const double spacing = rd.number(f, fp, "spacing", 2.1 * dist.max(), 2 * dist.max(), kInf);
+    const double jitter = rd.number(f, fp, "jitter", 0.05 * (spacing - 2 * dist.max()) + 0.01 * dist.mean, 0,
+                                    0.5 * spacing);
+    pos = lattice_sites(region, spacing, dist.max(), jitter, int(count), rng);
+    if (long(pos.size()) < count)
+      rd.fail(Reader::join(fp, "count"), std::to_string(count) + " grains do not fit in the region at spacing " +
+                                              std::to_string(spacing) + " m (room for " +
+                                              std::to_string(pos.size()) + ")");
+    radii = draw_radii(dist, int(pos.size()), rng);
+  } else {
+    std::string file = rd.text(g, path, "file", "");
+    // A relative path is taken from the scenario file's folder.
+    const auto slash = rd.source().rfind('/');
+    if (!file.empty() && file[0] != '/' && slash != std::string::npos) file = rd.source().substr(0, slash + 1) + file;
+    for (const auto& rec : read_sphere_data(file)) {
+      pos.push_back(rec.pos);
+      radii.push_back(rec.radius);
+    }
+  }
+  for (size_t k = 0; k < pos.size(); ++k) add_grain(m, radii[k], mat, fixed);
+  grp.count = m.n_grains - grp.first;
+  sc.groups.push_back(grp);
+  // Kinematics are kept aside until the state exists.
+  for (size_t k = 0; k < pos.size(); ++k) {
+    sc.initial.pos.push_back(pos[k]);
+    sc.initial.vel.push_back(vel);
+    sc.initial.omega.push_back(omg);
+  }
+}
+
+void apply_override(YAML::Node root, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError("--set '" + assignment + "': expected dotted.key=value");
+  const std::string key = assignment.substr(0, eq);
+  YAML::Node value;
+  try {
+    value = YAML::Load(assignment.substr(eq + 1));
+  } catch (const YAML::Exception& e) {
+    throw InputError("--set '" + assignment + "': value is not valid YAML: " + e.what());
+  }
+  std::vector<std::string> parts;
+  std::stringstream ss(key);
+  for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
+  // Walk with fresh handles: yaml-cpp node assignment rebinds, so recurse.
+  std::function<void(YAML::Node, size_t)> set = [&](YAML::Node node, size_t i) {
+    if (i + 1 == parts.size()) {
+      node[parts[i]] = value;
+      return;
+    }
+    YAML::Node child = node[parts[i]];
+    if (!child || !child.IsMap()) {
+      node[parts[i]] = YAML::Node(YAML::NodeType::Map);
+      child = node[parts[i]];
+    }
+    set(child, i + 1);
+  };
+  set(root, 0);
+}
+
+}  // namespace
+
+bool material_preset(const std::string& name, Material& out) {
+  const auto it = presets().find(name);
+  if (it == presets().end()) return false;
+  out = it->second;
+  return true;
+}
+
+const GrainGroup* Scenario::group(const std::string& n) const {
+  for (const auto& g : groups)
+    if (g.name == n) return &g;
+  return nullptr;
+}
+
+Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
+  const Reader rd(source);
+  if (!root || !root.IsMap()) throw InputError(source + ": expected a YAML mapping at the top level");
+  rd.only(root, "",
+          {"name", "seed", "gravity", "contact", "guards", "materials", "walls", "grains", "stages", "output"});
+  Scenario sc;
+  sc.file = source;
+  sc.name = rd.text(root, "", "name", "scenario");
+  sc.seed = static_cast<uint64_t>(rd.integer(root, "", "seed", 1, 0, std::numeric_limits<long>::max()));
+  std::mt19937_64 rng(sc.seed);
+  Model& m = sc.model;
+  m.gravity = rd.vec3(root, "", "gravity", Vec3(0, 0, -9.81));
+
+  // Materials (an ordered mapping name -> fields).
+  const YAML::Node mats = rd.map(root, "", "materials", true);
+  for (const auto& kv : mats) {
+    const std::string name = kv.first.as<std::string>();
+    if (!kv.second.IsMap()) rd.fail("materials." + name, "expected a mapping of material fields");
+    m.materials.push_back(parse_material(rd, kv.second, "materials." + name, name));
+  }
+
+  // Walls.
+  if (const YAML::Node walls = root["walls"]) {
+    if (!walls.IsSequence()) rd.fail("walls", "expected a list of walls");
+    for (size_t i = 0; i < walls.size(); ++i)
+      m.walls.push_back(parse_wall(rd, m, walls[i], "walls[" + std::to_string(i) + "]"));
+  }
+
+  // Grains.
+  const YAML::Node grains = root["grains"];
+  if (!grains || !grains.IsSequence() || grains.size() == 0) rd.fail("grains", "expected a non-empty list");
+  for (size_t i = 0; i < grains.size(); ++i)
+    parse_grains(rd, sc, grains[i], "grains[" + std::to_string(i) + "]", rng);
+
+  // Contact law, stiffness and time step.
+  const YAML::Node c = rd.map(root, "", "contact", false);
+  rd.only(c, "contact", {"model", "kn", "v_max", "x_max", "steps_per_contact", "dt", "skin", "partitions"});
+  m.contact_model = rd.choice(c, "contact", "model", "linear", {"linear", "hertz_mindlin"}) == "linear"
+                        ? ContactModel::Linear
+                        : ContactModel::HertzMindlin;
+  double mean_mass = 0, min_r = 1e300;
+  for (int i = 0; i < m.n_grains; ++i) {
+    const double r = m.grain_radius[i];
+    mean_mass += 4.0 / 3.0 * M_PI * r * r * r * m.materials[m.grain_material[i]].density;
+    min_r = std::min(min_r, r);
+  }
+  mean_mass /= m.n_grains;
+  sc.v_ref = rd.number(c, "contact", "v_max", 1.0, 0, 1e5, true);
+  const double x_max = rd.number(c, "contact", "x_max", 0.01, 0, 0.5, true) * min_r;
+  if (Reader::get(c, "kn") && !(c["kn"].IsScalar() && c["kn"].Scalar() == "rule"))
+    m.kn = rd.number(c["kn"], "contact.kn", 0, kInf, true);
+  else
+    m.kn = kn_rule(mean_mass, sc.v_ref, x_max);
+  const double n_steps = rd.number(c, "contact", "steps_per_contact", 30, 1, 1e6);
+  if (Reader::get(c, "dt")) {
+    m.dt = rd.number(c["dt"], "contact.dt", 0, 1, true);
+  } else if (m.contact_model == ContactModel::Linear) {
+    m.dt = dt_rule(mean_mass, m.kn, n_steps);
+  } else {
+    rd.fail("contact.dt", "missing: the Hertz–Mindlin law needs an explicit dt");
+  }
+  m.skin = rd.number(c, "contact", "skin", 0, 0, kInf);
+  m.partitions = int(rd.integer(c, "contact", "partitions", 4, 1, 256));
+
+  const YAML::Node gd = rd.map(root, "", "guards", false);
+  rd.only(gd, "guards", {"max_overlap_ratio", "allow_under_resolved"});
+  m.guards.max_overlap_ratio = rd.number(gd, "guards", "max_overlap_ratio", 0.25, 0, 2, true);
+  m.guards.allow_under_resolved = rd.boolean(gd, "guards", "allow_under_resolved", false);
+
+  finalize_model(m);
+
+  // Resolution report: warn below 10 steps per contact, refuse below 4.
+  sc.resolution = pair_resolution(m, sc.v_ref);
+  for (const auto& r : sc.resolution) {
+    std::ostringstream os;
+    os << r.label << ": " << r.steps << " steps per contact";
+    if (r.steps < m.guards.min_steps_per_contact_refuse && !m.guards.allow_under_resolved)
+      rd.fail("contact.dt", os.str() + " (below 4; set guards.allow_under_resolved: true to run anyway)");
+    if (r.steps < m.guards.min_steps_per_contact_warn) sc.warnings.push_back(os.str() + " (below 10)");
+  }
+
+  // Initial state.
+  std::vector<Vec3> pos = std::move(sc.initial.pos), vel = std::move(sc.initial.vel),
+                    omg = std::move(sc.initial.omega);
+  sc.initial = make_state(m);
+  sc.initial.pos = pos;
+  sc.initial.vel = vel;
+  sc.initial.omega = omg;
+
+  // Stages.
+  if (const YAML::Node st = root["stages"]) {
+    if (!st.IsSequence() || st.size() == 0) rd.fail("stages", "expected a non-empty list");
+    for (size_t i = 0; i < st.size(); ++i) {
+      const std::string p = "stages[" + std::to_string(i) + "]";
+      rd.only(st[i], p, {"name", "duration", "hold", "until_rms_speed", "until_max_speed", "check_every"});
+      Stage s;
+      s.name = rd.text(st[i], p, "name", "stage" + std::to_string(i));
+      s.duration = rd.number(st[i], p, "duration", 0, 0, 1e9, true);
+      if (!st[i]["duration"]) rd.fail(p + ".duration", "missing (simulated seconds, > 0)");
+      if (const YAML::Node h = st[i]["hold"]) {
+        if (!h.IsSequence()) rd.fail(p + ".hold", "expected a list of grain group names");
+        for (const auto& x : h) {
+          const std::string gname = x.as<std::string>();
+          if (!sc.group(gname)) rd.fail(p + ".hold", "unknown grain group '" + gname + "'");
+          s.hold.push_back(gname);
+        }
+      }
+      s.until_rms_speed = rd.number(st[i], p, "until_rms_speed", -1, -1, kInf);
+      s.until_max_speed = rd.number(st[i], p, "until_max_speed", -1, -1, kInf);
+      s.check_every = rd.number(st[i], p, "check_every", 0.01, 0, kInf, true);
+      sc.stages.push_back(s);
+    }
+  } else {
+    rd.fail("stages", "missing (a list of {name, duration, ...})");
+  }
+  const YAML::Node out = rd.map(root, "", "output", false);
+  rd.only(out, "output", {"every"});
+  sc.output_every = rd.number(out, "output", "every", 0.01, 0, kInf, true);
+  return sc;
+}
+
+Scenario parse_scenario_text(const std::string& yaml_text, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw InputError(source + ": not valid YAML: " + e.what());
+  }
+  return parse_scenario(root, source);
+}
+
+Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open scenario file");
+  YAML::Node root;
+  try {
+    root = YAML::Load(in);
+  } catch (const YAML::Exception& e) {
+    throw InputError(path + ": not valid YAML: " + e.what());
+  }
+  for (const auto& o : overrides) apply_override(root, o);
+  return parse_scenario(root, path);
+}
+
+}  // namespace rt

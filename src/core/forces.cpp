@@ -77,6 +77,8 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* F, Vec3* T, Threa
       T[i] += out.torque_i;
       T[j] += out.torque_j;
       ++sc.contacts;
+      if (s.log_contacts)
+        sc.log.push_back({i, j, in.x, out.fn, out.ft, out.mr, out.mt, law.mu_s, law.mu_r, law.mu_t, law.beta, in.reff});
       const double ratio = in.x / std::min(ri, rj);
       if (ratio > sc.max_overlap_ratio) {
         sc.max_overlap_ratio = ratio;
@@ -122,6 +124,9 @@ void wall_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
     s.force[i] += out.force_i;
     s.torque[i] += out.torque_i;
     ++sc.contacts;
+    if (s.log_contacts)
+      sc.log.push_back({i, -1 - wl.wall[k], in.x, out.fn, out.ft, out.mr, out.mt, law.mu_s, law.mu_r, law.mu_t,
+                        law.beta, in.reff});
     const double ratio = in.x / ri;
     if (ratio > sc.max_overlap_ratio) {
       sc.max_overlap_ratio = ratio;
@@ -135,6 +140,7 @@ void force_pass(const Model& m, State& s) {
   const int P = m.partitions;
   const int n = m.n_grains;
   for (auto& sc : s.scratch) {
+    if (s.log_contacts) sc.log.clear();
     sc.contacts = 0;
     sc.max_overlap_ratio = 0;
     sc.max_overlap_grain = -1;

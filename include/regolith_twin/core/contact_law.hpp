@@ -36,6 +36,9 @@ struct PairOutput {
   Vec3 torque_i;   // torque on i, N m
   Vec3 torque_j;   // torque on j, N m
   double fn;       // normal force magnitude used for the friction limits, N
+  double ft = 0;   // |F_T|, N (diagnostics)
+  double mr = 0;   // |M_R|, N m (diagnostics)
+  double mt = 0;   // |M_T|, N m (diagnostics)
 };
 
 namespace detail {
@@ -123,6 +126,7 @@ inline PairOutput pair_contact(const PairLaw& law, const PairInput& in, PairSpri
   detail::rotate_into_plane(sp.s, n);
   const Vec3 ft = detail::slider(sp.s, ut, k.kt, k.ct, law.mu_s * out.fn, dt);
   out.force_i += ft;
+  out.ft = ft.norm();
   const Vec3 tq = n.cross(ft);
   out.torque_i = in.li * tq;
   out.torque_j = in.lj * tq;
@@ -139,12 +143,14 @@ inline PairOutput pair_contact(const PairLaw& law, const PairInput& in, PairSpri
                                      law.mu_r * br * out.fn, dt);
       out.torque_i += mr;
       out.torque_j -= mr;
+      out.mr = mr.norm();
     }
     if (law.twisting) {
       const double mt = detail::slider1(sp.twist, wn, 2.0 * k.kt * br2, 2.0 * k.ct * br2,
                                         law.mu_t * br * law.mu_s * out.fn, dt);
       out.torque_i += mt * n;
       out.torque_j -= mt * n;
+      out.mt = std::fabs(mt);
     }
   }
   return out;

@@ -36,6 +36,17 @@ struct WallList {
   int size() const { return static_cast<int>(grain.size()); }
 };
 
+// One evaluated contact, recorded only while State::log_contacts is set
+// (verification and diagnostics; the normal step records nothing).
+struct ContactRecord {
+  int i, j;            // grains; j = -1 - wall index for a wall contact
+  double overlap;      // m
+  double fn;           // normal force used for the limits, N
+  double ft;           // |F_T|, N
+  double mr, mt;       // |M_R|, |M_T|, N m
+  double mu_s, mu_r, mu_t, beta, reff;  // law constants of the pair
+};
+
 // Per-thread accumulators of one force pass (merged in thread order).
 struct ThreadScratch {
   std::vector<Vec3> force;      // force on grains, N (thread 0 writes State::force)
@@ -44,6 +55,7 @@ struct ThreadScratch {
   double max_overlap_ratio = 0;
   int max_overlap_grain = -1;
   long contacts = 0;
+  std::vector<ContactRecord> log;  // filled only while State::log_contacts
 };
 
 struct StepStats {
@@ -84,6 +96,7 @@ struct State {
   WallList wall_pairs_next;
 
   StepStats stats;
+  bool log_contacts = false;  // record every contact of each force pass in scratch[p].log
 };
 
 // A state for model m: zero kinematics (callers set pos, vel, omega), every

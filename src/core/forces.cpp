@@ -78,7 +78,8 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* F, Vec3* T, Threa
       T[j] += out.torque_j;
       ++sc.contacts;
       if (s.log_contacts)
-        sc.log.push_back({i, j, in.x, out.fn, out.ft, out.mr, out.mt, law.mu_s, law.mu_r, law.mu_t, law.beta, in.reff});
+        sc.log.push_back({i, j, in.x, out.fn, out.ft.norm(), out.mr.norm(), std::fabs(out.mt), law.mu_s, law.mu_r,
+                          law.mu_t, law.beta, in.reff});
       const double ratio = in.x / std::min(ri, rj);
       if (ratio > sc.max_overlap_ratio) {
         sc.max_overlap_ratio = ratio;
@@ -125,8 +126,8 @@ void wall_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
     s.torque[i] += out.torque_i;
     ++sc.contacts;
     if (s.log_contacts)
-      sc.log.push_back({i, -1 - wl.wall[k], in.x, out.fn, out.ft, out.mr, out.mt, law.mu_s, law.mu_r, law.mu_t,
-                        law.beta, in.reff});
+      sc.log.push_back({i, -1 - wl.wall[k], in.x, out.fn, out.ft.norm(), out.mr.norm(), std::fabs(out.mt), law.mu_s,
+                        law.mu_r, law.mu_t, law.beta, in.reff});
     const double ratio = in.x / ri;
     if (ratio > sc.max_overlap_ratio) {
       sc.max_overlap_ratio = ratio;

@@ -164,6 +164,8 @@ void build_walls(const Model& m, State& s) {
   std::swap(s.wall_pairs, s.wall_pairs_next);
 }
 
+}  // namespace
+
 // Split rows into partitions of about equal entry counts; record the grain
 // range each partition writes so merging touches only that range.
 void partition_work(const Model& m, State& s) {
@@ -196,8 +198,6 @@ void partition_work(const Model& m, State& s) {
   }
   for (int p = 1; p <= P; ++p) s.thread_wall_begin[p] = std::max(s.thread_wall_begin[p], s.thread_wall_begin[p - 1]);
 }
-
-}  // namespace
 
 bool lists_need_rebuild(const Model& m, const State& s) {
   if (!s.lists_valid) return true;

@@ -391,16 +391,29 @@ void apply_override(YAML::Node root, const std::string& assignment) {
   std::vector<std::string> parts;
   std::stringstream ss(key);
   for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
-  // Walk with fresh handles: yaml-cpp node assignment rebinds, so recurse.
+  // Walk with fresh handles (yaml-cpp assignment rebinds). A numeric part
+  // indexes a list: --set stages.0.duration=0.1
   std::function<void(YAML::Node, size_t)> set = [&](YAML::Node node, size_t i) {
+    const std::string& part = parts[i];
+    const bool index = !part.empty() && part.find_first_not_of("0123456789") == std::string::npos;
+    if (index && !node.IsSequence()) throw InputError("--set '" + assignment + "': '" + part + "' indexes a non-list");
+    if (index && std::stoul(part) >= node.size())
+      throw InputError("--set '" + assignment + "': index " + part + " is past the end of the list");
     if (i + 1 == parts.size()) {
-      node[parts[i]] = value;
+      if (index)
+        node[std::stoul(part)] = value;
+      else
+        node[part] = value;
       return;
     }
-    YAML::Node child = node[parts[i]];
-    if (!child || !child.IsMap()) {
-      node[parts[i]] = YAML::Node(YAML::NodeType::Map);
-      child = node[parts[i]];
+    if (index) {
+      set(node[std::stoul(part)], i + 1);
+      return;
+    }
+    YAML::Node child = node[part];
+    if (!child || !(child.IsMap() || child.IsSequence())) {
+      node[part] = YAML::Node(YAML::NodeType::Map);
+      child = node[part];
     }
     set(child, i + 1);
   };

@@ -36,9 +36,9 @@ struct PairOutput {
   Vec3 torque_i;   // torque on i, N m
   Vec3 torque_j;   // torque on j, N m
   double fn;       // normal force magnitude used for the friction limits, N
-  double ft = 0;   // |F_T|, N (diagnostics)
-  double mr = 0;   // |M_R|, N m (diagnostics)
-  double mt = 0;   // |M_T|, N m (diagnostics)
+  Vec3 ft;         // tangential force on i, N
+  Vec3 mr = Vec3::Zero();  // rolling moment on i, N m
+  double mt = 0;   // twisting moment on i along n, N m
 };
 
 namespace detail {
@@ -55,13 +55,14 @@ inline void rotate_into_plane(Vec3& s, const Vec3& n) {
 // Spring–dashpot–slider update shared by sliding and rolling resistance:
 // add rate*dt, shorten the spring to the cap, scale the total (spring +
 // dashpot) to the cap without touching the spring. Returns k*s + c*rate.
+// Magnitudes are compared squared, so a sticking contact takes no sqrt.
 inline Vec3 slider(Vec3& s, const Vec3& rate, double k, double c, double cap, double dt) {
   s += rate * dt;
-  const double ks = k * s.norm();
-  if (ks > cap) s *= cap / ks;
+  const double ks2 = k * k * s.squaredNorm();
+  if (ks2 > cap * cap) s *= cap / std::sqrt(ks2);
   Vec3 f = k * s + c * rate;
-  const double fm = f.norm();
-  if (fm > cap) f *= cap / fm;
+  const double f2 = f.squaredNorm();
+  if (f2 > cap * cap) f *= cap / std::sqrt(f2);
   return f;
 }
 
@@ -126,7 +127,7 @@ inline PairOutput pair_contact(const PairLaw& law, const PairInput& in, PairSpri
   detail::rotate_into_plane(sp.s, n);
   const Vec3 ft = detail::slider(sp.s, ut, k.kt, k.ct, law.mu_s * out.fn, dt);
   out.force_i += ft;
-  out.ft = ft.norm();
+  out.ft = ft;
   const Vec3 tq = n.cross(ft);
   out.torque_i = in.li * tq;
   out.torque_j = in.lj * tq;
@@ -143,14 +144,14 @@ inline PairOutput pair_contact(const PairLaw& law, const PairInput& in, PairSpri
                                      law.mu_r * br * out.fn, dt);
       out.torque_i += mr;
       out.torque_j -= mr;
-      out.mr = mr.norm();
+      out.mr = mr;
     }
     if (law.twisting) {
       const double mt = detail::slider1(sp.twist, wn, 2.0 * k.kt * br2, 2.0 * k.ct * br2,
                                         law.mu_t * br * law.mu_s * out.fn, dt);
       out.torque_i += mt * n;
       out.torque_j -= mt * n;
-      out.mt = std::fabs(mt);
+      out.mt = mt;
     }
   }
   return out;

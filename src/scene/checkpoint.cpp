@@ -1,0 +1,177 @@
+// Binary checkpoints: header, sections, FNV-1a checksum.
+#include "regolith_twin/scene/checkpoint.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "regolith_twin/core/neighbours.hpp"
+
+namespace rt {
+namespace {
+
+constexpr char kMagic[8] = {'R', 'G', 'T', 'W', 'C', 'K', 'P', 'T'};
+constexpr uint32_t kVersion = 1;
+
+uint64_t fnv1a(const char* p, size_t n, uint64_t h = 1469598103934665603ULL) {
+  for (size_t i = 0; i < n; ++i) {
+    h ^= static_cast<unsigned char>(p[i]);
+    h *= 1099511628211ULL;
+  }
+  return h;
+}
+
+// Fingerprint of the static grain description a state belongs to.
+uint64_t model_fingerprint(const Model& m) {
+  uint64_t h = fnv1a(reinterpret_cast<const char*>(m.grain_radius.data()), m.grain_radius.size() * sizeof(double));
+  h = fnv1a(reinterpret_cast<const char*>(m.grain_material.data()), m.grain_material.size() * sizeof(int), h);
+  return fnv1a(reinterpret_cast<const char*>(m.grain_fixed.data()), m.grain_fixed.size(), h);
+}
+
+class Writer {
+ public:
+  template <class T>
+  void pod(const T& v) {
+    raw(&v, sizeof v);
+  }
+  template <class T>
+  void vec(const std::vector<T>& v) {
+    pod<uint64_t>(v.size());
+    raw(v.data(), v.size() * sizeof(T));
+  }
+  void raw(const void* p, size_t n) { buf.append(static_cast<const char*>(p), n); }
+  std::string buf;
+};
+
+class Reader {
+ public:
+  Reader(const std::string& path, const std::string& data) : path_(path), data_(data) {}
+  template <class T>
+  T pod() {
+    T v;
+    raw(&v, sizeof v);
+    return v;
+  }
+  template <class T>
+  void vec(std::vector<T>& v, uint64_t expect = UINT64_MAX) {
+    const uint64_t n = pod<uint64_t>();
+    if (expect != UINT64_MAX && n != expect) fail("section length mismatch");
+    if (n > (data_.size() - pos_) / sizeof(T)) fail("truncated file");
+    v.resize(n);
+    raw(v.data(), n * sizeof(T));
+  }
+  void raw(void* p, size_t n) {
+    if (n > data_.size() - pos_) fail("truncated file");
+    std::memcpy(p, data_.data() + pos_, n);
+    pos_ += n;
+  }
+  [[noreturn]] void fail(const std::string& what) const { throw InputError(path_ + ": not a usable checkpoint: " + what); }
+  size_t pos() const { return pos_; }
+
+ private:
+  const std::string& path_;
+  const std::string& data_;
+  size_t pos_ = 0;
+};
+
+template <class List>
+void put_springs(Writer& w, const List& l) {
+  w.vec(l.spring_t);
+  w.vec(l.spring_r);
+  w.vec(l.spring_w);
+  w.vec(l.touching);
+}
+
+template <class List>
+void get_springs(Reader& r, List& l, uint64_t n) {
+  r.vec(l.spring_t, n);
+  r.vec(l.spring_r, n);
+  r.vec(l.spring_w, n);
+  r.vec(l.touching, n);
+}
+
+}  // namespace
+
+void save_checkpoint(const std::string& path, const Model& m, const State& s) {
+  Writer w;
+  w.raw(kMagic, sizeof kMagic);
+  w.pod(kVersion);
+  w.pod<uint64_t>(m.n_grains);
+  w.pod(model_fingerprint(m));
+  w.pod(s.time);
+  w.pod<int64_t>(s.step);
+  w.pod<int64_t>(s.rebuilds);
+  w.pod<uint8_t>(s.lists_valid && s.forces_valid);
+  w.pod(s.stats.max_disp2);
+  for (const auto* v : {&s.pos, &s.vel, &s.omega, &s.force, &s.torque, &s.pos_at_build}) w.vec(*v);
+  w.vec(s.pairs.row_start);
+  w.vec(s.pairs.partner);
+  put_springs(w, s.pairs);
+  w.vec(s.wall_pairs.grain);
+  w.vec(s.wall_pairs.wall);
+  put_springs(w, s.wall_pairs);
+  const uint64_t sum = fnv1a(w.buf.data(), w.buf.size());
+  w.pod(sum);
+
+  const std::string tmp = path + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) throw InputError(path + ": cannot write checkpoint");
+  const bool ok = std::fwrite(w.buf.data(), 1, w.buf.size(), f) == w.buf.size() && std::fflush(f) == 0 &&
+                  ::fsync(fileno(f)) == 0;
+  if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw InputError(path + ": could not write checkpoint");
+  }
+}
+
+State load_checkpoint(const std::string& path, const Model& m) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open checkpoint");
+  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  Reader r(path, data);
+  if (data.size() < sizeof kMagic + 8 || std::memcmp(data.data(), kMagic, sizeof kMagic) != 0)
+    r.fail("wrong file type (no checkpoint header)");
+  uint64_t stored_sum;
+  std::memcpy(&stored_sum, data.data() + data.size() - 8, 8);
+  if (fnv1a(data.data(), data.size() - 8) != stored_sum) r.fail("checksum mismatch (truncated or corrupted file)");
+  char magic[8];
+  r.raw(magic, 8);
+  const uint32_t version = r.pod<uint32_t>();
+  if (version != kVersion)
+    r.fail("format version " + std::to_string(version) + ", this build reads version " + std::to_string(kVersion));
+  const uint64_t n = r.pod<uint64_t>();
+  if (n != uint64_t(m.n_grains))
+    r.fail("it holds " + std::to_string(n) + " grains, the scenario has " + std::to_string(m.n_grains));
+  if (r.pod<uint64_t>() != model_fingerprint(m)) r.fail("grain radii or materials differ from the scenario's");
+  State s = make_state(m);
+  s.time = r.pod<double>();
+  s.step = r.pod<int64_t>();
+  s.rebuilds = r.pod<int64_t>();
+  const bool live = r.pod<uint8_t>() != 0;
+  s.stats.max_disp2 = r.pod<double>();
+  for (auto* v : {&s.pos, &s.vel, &s.omega, &s.force, &s.torque, &s.pos_at_build}) r.vec(*v, n);
+  r.vec(s.pairs.row_start);
+  r.vec(s.pairs.partner);
+  if (live && s.pairs.row_start.size() != n + 1) r.fail("pair list does not match the grain count");
+  get_springs(r, s.pairs, s.pairs.partner.size());
+  r.vec(s.wall_pairs.grain);
+  r.vec(s.wall_pairs.wall);
+  get_springs(r, s.wall_pairs, s.wall_pairs.grain.size());
+  if (r.pos() + 8 != data.size()) r.fail("unexpected trailing data");
+  for (int p : s.pairs.partner)
+    if (p < 0 || p >= m.n_grains) r.fail("pair list refers to a grain that does not exist");
+  for (size_t k = 0; k < s.wall_pairs.grain.size(); ++k)
+    if (s.wall_pairs.grain[k] < 0 || s.wall_pairs.grain[k] >= m.n_grains || s.wall_pairs.wall[k] < 0 ||
+        s.wall_pairs.wall[k] >= int(m.walls.size()))
+      r.fail("wall list refers to a grain or wall that does not exist");
+  if (live) {
+    partition_work(m, s);
+    s.lists_valid = s.forces_valid = true;
+  }
+  return s;
+}
+
+}  // namespace rt

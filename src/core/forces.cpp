@@ -40,7 +40,6 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* F, Vec3* T, Threa
   for (int i = rb; i < re; ++i) {
     const Vec3 xi = s.pos[i];
     const double ri = m.grain_radius[i];
-    const double inv_mi = m.grain_inv_mass[i];
     const int mat_i = m.grain_material[i];
     for (int k = pl.row_start[i]; k < pl.row_start[i + 1]; ++k) {
       const int j = pl.partner[k];
@@ -58,14 +57,14 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* F, Vec3* T, Threa
         continue;
       }
       pl.touching[k] = 1;
-      const double dist = std::sqrt(dist2);
+      const double inv_dist = 1.0 / std::sqrt(dist2);
       PairInput in;
-      in.n = d / dist;
-      in.x = rs - dist;
+      in.n = d * inv_dist;
+      in.x = rs - dist2 * inv_dist;
       in.li = ri - 0.5 * in.x;
       in.lj = rj - 0.5 * in.x;
       in.reff = ri * rj / rs;
-      in.mstar = 1.0 / (inv_mi + m.grain_inv_mass[j]);
+      in.sqrt_mstar = pl.sqrt_mstar[k];
       in.vrel = s.vel[j] - s.vel[i];
       in.wi = s.omega[i];
       in.wj = s.omega[j];
@@ -80,9 +79,9 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* F, Vec3* T, Threa
       if (s.log_contacts)
         sc.log.push_back({i, j, in.x, out.fn, out.ft.norm(), out.mr.norm(), std::fabs(out.mt), law.mu_s, law.mu_r,
                           law.mu_t, law.beta, in.reff});
-      const double ratio = in.x / std::min(ri, rj);
-      if (ratio > sc.max_overlap_ratio) {
-        sc.max_overlap_ratio = ratio;
+      const double rmin = std::min(ri, rj);
+      if (in.x > sc.max_overlap_ratio * rmin) {
+        sc.max_overlap_ratio = in.x / rmin;
         sc.max_overlap_grain = i;
       }
     }
@@ -115,7 +114,7 @@ void wall_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
     in.li = ri - 0.5 * in.x;
     in.lj = 0;
     in.reff = ri;
-    in.mstar = m.grain_mass[i];
+    in.sqrt_mstar = std::sqrt(m.grain_mass[i]);
     in.vrel = -s.vel[i];
     in.wi = s.omega[i];
     in.wj.setZero();

@@ -169,6 +169,12 @@ void build_walls(const Model& m, State& s) {
 // Split rows into partitions of about equal entry counts; record the grain
 // range each partition writes so merging touches only that range.
 void partition_work(const Model& m, State& s) {
+  // Per-entry constants of the pair law.
+  PairList& pairs = s.pairs;
+  pairs.sqrt_mstar.resize(pairs.size());
+  for (int i = 0; i < m.n_grains; ++i)
+    for (int k = pairs.row_start[i]; k < pairs.row_start[i + 1]; ++k)
+      pairs.sqrt_mstar[k] = std::sqrt(1.0 / (m.grain_inv_mass[i] + m.grain_inv_mass[pairs.partner[k]]));
   const int P = m.partitions;
   const int n = m.n_grains;
   const PairList& pl = s.pairs;

@@ -16,9 +16,8 @@ void prime(const Model& m, State& s) {
 
 void step(const Model& m, State& s) {
   if (!s.forces_valid) prime(m, s);
-  kick(m, s, 0.5 * m.dt);                                          // integrate: half kick
+  kick_drift(m, s, 0.5 * m.dt, m.dt);                              // integrate: half kick, drift
   check_guards(m, s);
-  drift(m, s, m.dt);                                               //            drift
   if (lists_need_rebuild(m, s)) build_neighbour_lists(m, s);       // neighbours
   compute_forces(m, s);                                            // contacts -> forces
   kick(m, s, 0.5 * m.dt);                                          // integrate: half kick

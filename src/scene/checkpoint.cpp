@@ -128,9 +128,11 @@ void save_checkpoint(const std::string& path, const Model& m, const State& s) {
 }
 
 State load_checkpoint(const std::string& path, const Model& m) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw InputError(path + ": cannot open checkpoint");
-  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string data(static_cast<size_t>(in.tellg()), '\0');
+  in.seekg(0);
+  if (!in.read(data.data(), data.size())) throw InputError(path + ": cannot read checkpoint");
   Reader r(path, data);
   if (data.size() < sizeof kMagic + 8 || std::memcmp(data.data(), kMagic, sizeof kMagic) != 0)
     r.fail("wrong file type (no checkpoint header)");

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -109,10 +110,13 @@ int main(int argc, char** argv) {
       rt::step(m, s);  // warm caches and first-touch pages outside the timing
       for (int b = 1; b <= blocks; ++b) {
         const auto t0 = std::chrono::steady_clock::now();
+        const std::clock_t c0 = std::clock();
         for (long k = 0; k < block_steps; ++k) rt::step(m, s);
         const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        std::printf("RESULT engine=regolith label=%s threads=%d block=%d steps=%ld seconds=%.4f particle_steps_per_s=%.4g\n",
-                    label.c_str(), t, b, block_steps, sec, double(block_steps) * m.n_grains / sec);
+        const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
+        std::printf("RESULT engine=regolith label=%s threads=%d block=%d steps=%ld seconds=%.4f "
+                    "particle_steps_per_s=%.4g cpu_seconds=%.4f\n",
+                    label.c_str(), t, b, block_steps, sec, double(block_steps) * m.n_grains / sec, cpu);
         std::fflush(stdout);
       }
     }

@@ -19,7 +19,7 @@ struct PairInput {
   double x;        // overlap, m (> 0)
   double li, lj;   // lever arms r - x/2, m
   double reff;     // effective radius R = r_i r_j / (r_i + r_j), m
-  double mstar;    // reduced mass, kg
+  double sqrt_mstar;  // square root of the reduced mass, sqrt(kg)
   Vec3 vrel;       // v_j - v_i, m/s
   Vec3 wi, wj;     // angular velocities, rad/s
 };
@@ -87,9 +87,8 @@ struct LawTerms {
 };
 
 template <ContactModel M>
-inline LawTerms law_terms(const PairLaw& law, double x, double reff, double mstar) {
+inline LawTerms law_terms(const PairLaw& law, double x, double reff, double sm) {
   LawTerms t;
-  const double sm = std::sqrt(mstar);
   if constexpr (M == ContactModel::Linear) {
     t.kn_eff = law.kn;
     t.fn_elastic = law.kn * x;
@@ -110,7 +109,7 @@ inline LawTerms law_terms(const PairLaw& law, double x, double reff, double msta
 // Force and torques of one touching pair; updates the springs.
 template <ContactModel M, bool Resist>
 inline PairOutput pair_contact(const PairLaw& law, const PairInput& in, PairSprings sp, double dt) {
-  const LawTerms k = law_terms<M>(law, in.x, in.reff, in.mstar);
+  const LawTerms k = law_terms<M>(law, in.x, in.reff, in.sqrt_mstar);
   const Vec3& n = in.n;
 
   // Relative velocity of the contact points and its normal / tangential parts.

@@ -14,8 +14,9 @@ bool lists_need_rebuild(const Model& m, const State& s);
 // fixed partition of the rows used by the force pass.
 void build_neighbour_lists(const Model& m, State& s);
 
-// Recompute the fixed work partition of the current lists (done by every
-// build; needed again only after lists are restored from a checkpoint).
+// Recompute the per-entry constants and the fixed work partition of the
+// current lists (done by every build; needed again only after lists are
+// restored from a checkpoint).
 void partition_work(const Model& m, State& s);
 
 }  // namespace rt

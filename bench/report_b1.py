@@ -57,7 +57,7 @@ def main():
     if micro:
         out.append("")
         out.append(f"Compute-bound OpenMP microbenchmark on this machine: 2 threads / 1 thread = "
-                   f"{float(micro[-1]['ratio']):.2f}×.")
+                   f"{float(micro[-1].get('ratio_2_over_1', micro[-1].get('ratio', 'nan'))):.2f}×.")
     checks = [r for r in rows if r["_kind"] in ("CHECK",)]
     if checks:
         out.append("")

@@ -135,6 +135,7 @@ void build_walls(const Model& m, State& s) {
   for (int i = 0; i < m.n_grains; ++i) {
     if (m.grain_fixed[i]) continue;
     for (int w = 0; w < nw; ++w) {
+      if (!s.wall_on[w]) continue;
       if (wall_gap(m.walls[w], s.pos[i], m.grain_radius[i]).overlap > -m.skin) {
         nl.grain.push_back(i);
         nl.wall.push_back(w);
@@ -206,7 +207,7 @@ void partition_work(const Model& m, State& s) {
 }
 
 bool lists_need_rebuild(const Model& m, const State& s) {
-  if (!s.lists_valid) return true;
+  if (!s.lists_valid || s.rebuild_requested) return true;
   const double half = 0.5 * m.skin;
   return s.stats.max_disp2 > half * half;
 }
@@ -219,6 +220,7 @@ void build_neighbour_lists(const Model& m, State& s) {
   s.pos_at_build = s.pos;
   s.stats.max_disp2 = 0;
   s.lists_valid = true;
+  s.rebuild_requested = false;
   ++s.rebuilds;
 }
 

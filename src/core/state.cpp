@@ -12,6 +12,7 @@ State make_state(const Model& m) {
   s.force.assign(n, Vec3::Zero());
   s.torque.assign(n, Vec3::Zero());
   s.pos_at_build.assign(n, Vec3::Zero());
+  s.wall_on.assign(m.walls.size(), 1);
   s.scratch.resize(m.partitions);
   for (int p = 1; p < m.partitions; ++p) {
     s.scratch[p].force.assign(n, Vec3::Zero());

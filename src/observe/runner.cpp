@@ -132,6 +132,12 @@ RunReport run_scenario(const Scenario& sc, State& s, const RunOptions& opt) {
       std::fill(held.begin(), held.end(), 0);
       std::vector<Vec3> held_pos;
       std::vector<int> held_ids;
+      for (const auto& name : st.remove_walls)
+        for (size_t w = 0; w < m.walls.size(); ++w)
+          if (m.walls[w].name == name) {
+            s.wall_on[w] = 0;
+            s.rebuild_requested = true;
+          }
       for (const auto& name : st.hold) {
         const GrainGroup* g = sc.group(name);
         for (int i = g->first; i < g->first + g->count; ++i) {

@@ -14,7 +14,7 @@ namespace rt {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'G', 'T', 'W', 'C', 'K', 'P', 'T'};
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;
 
 uint64_t fnv1a(const char* p, size_t n, uint64_t h = 1469598103934665603ULL) {
   for (size_t i = 0; i < n; ++i) {
@@ -110,6 +110,7 @@ void save_checkpoint(const std::string& path, const Model& m, const State& s) {
   w.vec(s.pairs.row_start);
   w.vec(s.pairs.partner);
   put_springs(w, s.pairs);
+  w.vec(s.wall_on);
   w.vec(s.wall_pairs.grain);
   w.vec(s.wall_pairs.wall);
   put_springs(w, s.wall_pairs);
@@ -159,6 +160,7 @@ State load_checkpoint(const std::string& path, const Model& m) {
   r.vec(s.pairs.partner);
   if (live && s.pairs.row_start.size() != n + 1) r.fail("pair list does not match the grain count");
   get_springs(r, s.pairs, s.pairs.partner.size());
+  r.vec(s.wall_on, m.walls.size());
   r.vec(s.wall_pairs.grain);
   r.vec(s.wall_pairs.wall);
   get_springs(r, s.wall_pairs, s.wall_pairs.grain.size());

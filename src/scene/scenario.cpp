@@ -529,7 +529,8 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
     if (!st.IsSequence() || st.size() == 0) rd.fail("stages", "expected a non-empty list");
     for (size_t i = 0; i < st.size(); ++i) {
       const std::string p = "stages[" + std::to_string(i) + "]";
-      rd.only(st[i], p, {"name", "duration", "hold", "until_rms_speed", "until_max_speed", "check_every"});
+      rd.only(st[i], p,
+              {"name", "duration", "hold", "remove_walls", "until_rms_speed", "until_max_speed", "check_every"});
       Stage s;
       s.name = rd.text(st[i], p, "name", "stage" + std::to_string(i));
       s.duration = rd.number(st[i], p, "duration", 0, 0, 1e9, true);
@@ -540,6 +541,16 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
           const std::string gname = x.as<std::string>();
           if (!sc.group(gname)) rd.fail(p + ".hold", "unknown grain group '" + gname + "'");
           s.hold.push_back(gname);
+        }
+      }
+      if (const YAML::Node rw = st[i]["remove_walls"]) {
+        if (!rw.IsSequence()) rd.fail(p + ".remove_walls", "expected a list of wall names");
+        for (const auto& x : rw) {
+          const std::string wname = x.as<std::string>();
+          bool found = false;
+          for (const auto& w : m.walls) found = found || w.name == wname;
+          if (!found) rd.fail(p + ".remove_walls", "unknown wall '" + wname + "' (walls need a 'name')");
+          s.remove_walls.push_back(wname);
         }
       }
       s.until_rms_speed = rd.number(st[i], p, "until_rms_speed", -1, -1, kInf);

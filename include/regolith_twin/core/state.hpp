@@ -78,12 +78,15 @@ struct State {
   std::vector<Vec3> force;      // total force of the last force pass, N
   std::vector<Vec3> torque;     // total torque of the last force pass, N m
 
+  std::vector<uint8_t> wall_on;  // 1 while wall w takes part (a lifted cylinder is 0) (n_walls)
+
   // Neighbour bookkeeping.
   PairList pairs;
   WallList wall_pairs;
   std::vector<Vec3> pos_at_build;  // positions when the lists were last built
   long rebuilds = 0;
   bool lists_valid = false;
+  bool rebuild_requested = false;  // rebuild at the next step (walls switched on/off)
   bool forces_valid = false;
 
   // Thread partition of the pair rows, fixed between rebuilds (deterministic).

@@ -28,6 +28,7 @@ struct Stage {
   std::string name;
   double duration = 0;                // s of simulated time (maximum)
   std::vector<std::string> hold;      // groups held in place during the stage
+  std::vector<std::string> remove_walls;  // walls taken away when the stage starts (a lifted cylinder)
   double until_rms_speed = -1;        // end early once RMS grain speed is below this, m/s (<0: off)
   double until_max_speed = -1;        // ... and the max grain speed below this, m/s (<0: off)
   double check_every = 0.01;          // s between checks of the criteria

@@ -38,6 +38,19 @@
 #          (definitions: bench/postprocess_b1.py)
 #   SETTLE engine=E steps=S seconds=T cached=yes|no
 #   VERSION engine=E version=V package=DEBVERSION
+#   LOAD   engine=E ranks=N loadavg_before=L1 loadavg_after=L2
+#          (1-minute load average around a timed run: timings taken while
+#          the 2-core machine is busy with other work are not comparable)
+#
+# How the peers realise the contact law (details in the decks):
+#   both take the normal/tangential damping as a rate per unit effective mass
+#   (LAMMPS pair gran/hooke/history gamma_n, LIGGGHTS hooke/stiffness gamman
+#   with absolute_damping off), effective mass m_i m_j/(m_i+m_j) for pairs and
+#   m_i at walls, so gamma_n = C_n / m* and the walls get their own value
+#   (pair 2130.5 1/s, wall 1506.5 1/s; gamma_t = gamma_n / 2).
+#   Remaining difference: when the Coulomb limit is reached, LAMMPS caps
+#   |k_t s + m_eff gamma_t v_t| at mu |F_n|, LIGGGHTS caps |k_t s| and drops
+#   the tangential damping term while sliding.
 #
 # Environment:
 #   B1_CACHE         cache directory (default bench/.cache, git-ignored)
@@ -188,6 +201,8 @@ cmd_time() {
   dir="$(settle_dir "$engine")"
   base="$dir/time_r${nranks}_b${B1_BLOCK_STEPS}"
   rm -f "$base.log" "$base.dump"
+  local load0 load1
+  load0="$(cut -d' ' -f1 /proc/loadavg 2>/dev/null || echo nan)"
   run_engine "$engine" "$nranks" "$base.log" \
     -var mode time -var restart "$(settle_restart "$engine")" \
     -var dumpfile "$base.dump" -var block_steps "$B1_BLOCK_STEPS"
@@ -195,7 +210,9 @@ cmd_time() {
   results="$(parse_loop_times "$engine" "$nranks" "$base.log")"
   [[ "$(grep -c '^RESULT' <<<"$results")" == 3 ]] \
     || die "expected 3 timed blocks in $base.log"
+  load1="$(cut -d' ' -f1 /proc/loadavg 2>/dev/null || echo nan)"
   echo "$results"
+  echo "LOAD engine=$engine ranks=$nranks loadavg_before=$load0 loadavg_after=$load1"
   cmd_check "$engine" "$base.dump" final "ranks=$nranks"
 }
 

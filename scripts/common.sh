@@ -6,6 +6,9 @@ BUILD=${REGOLITH_BUILD:-$ROOT/build}
 BIN=$BUILD/devel/lib/regolith_twin
 # ROS and catkin tools run with the system interpreter, not a pyenv one.
 export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
+# Waiting OpenMP threads sleep instead of spinning: spinning threads starve
+# each other when the two cores are shared with other work.
+export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
 
 # Debian packages the build and tests need.
 BUILD_PACKAGES=(g++ make cmake catkin libeigen3-dev libyaml-cpp-dev googletest python3)

@@ -31,32 +31,49 @@ int thread_count() {
 #endif
 }
 
-// Grain–grain contacts of rows [rb, re) into F, T.
+// Grain–grain contacts of rows [rb, re) into F, T. Arrays are taken as
+// restrict pointers and row i's force is summed locally, so the compiler
+// keeps grain i in registers while it walks the row.
 template <ContactModel M, bool Resist>
-void pair_rows(const Model& m, State& s, int rb, int re, Vec3* F, Vec3* T, ThreadScratch& sc) {
+void pair_rows(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec3* __restrict T,
+               ThreadScratch& sc) {
   PairList& pl = s.pairs;
   const double dt = m.dt;
   const int nm = m.n_materials();
+  const Vec3* __restrict pos = s.pos.data();
+  const Vec3* __restrict vel = s.vel.data();
+  const Vec3* __restrict omega = s.omega.data();
+  const Vec3* __restrict vel_mid = s.vel_mid.data();
+  const Vec3* __restrict omega_mid = s.omega_mid.data();
+  const double* __restrict radius = m.grain_radius.data();
+  const int* __restrict material = m.grain_material.data();
+  const int* __restrict partner = pl.partner.data();
+  const int* __restrict row = pl.row_start.data();
+  uint8_t* __restrict touching = pl.touching.data();
+  long contacts = 0;
+  double max_ratio = sc.max_overlap_ratio;
+  int max_grain = sc.max_overlap_grain;
   for (int i = rb; i < re; ++i) {
-    const Vec3 xi = s.pos[i];
-    const double ri = m.grain_radius[i];
-    const int mat_i = m.grain_material[i];
-    for (int k = pl.row_start[i]; k < pl.row_start[i + 1]; ++k) {
-      const int j = pl.partner[k];
-      const Vec3 d = s.pos[j] - xi;
-      const double rj = m.grain_radius[j];
+    const Vec3 xi = pos[i], vi = vel[i], wi = omega[i], vi_mid = vel_mid[i], wi_mid = omega_mid[i];
+    const double ri = radius[i];
+    const PairLaw* laws = &m.pair_law[material[i] * nm];
+    Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
+    for (int k = row[i]; k < row[i + 1]; ++k) {
+      const int j = partner[k];
+      const Vec3 d = pos[j] - xi;
+      const double rj = radius[j];
       const double rs = ri + rj;
       const double dist2 = d.squaredNorm();
       if (dist2 >= rs * rs) {
-        if (pl.touching[k]) {  // contact ended: its history goes
-          pl.touching[k] = 0;
+        if (touching[k]) {  // contact ended: its history goes
+          touching[k] = 0;
           pl.spring_t[k].setZero();
           pl.spring_r[k].setZero();
           pl.spring_w[k] = 0;
         }
         continue;
       }
-      pl.touching[k] = 1;
+      touching[k] = 1;
       const double inv_dist = 1.0 / std::sqrt(dist2);
       PairInput in;
       in.n = d * inv_dist;
@@ -65,27 +82,35 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* F, Vec3* T, Threa
       in.lj = rj - 0.5 * in.x;
       in.reff = ri * rj / rs;
       in.sqrt_mstar = pl.sqrt_mstar[k];
-      in.vrel = s.vel[j] - s.vel[i];
-      in.wi = s.omega[i];
-      in.wj = s.omega[j];
-      const PairLaw& law = m.pair_law[mat_i * nm + m.grain_material[j]];
+      in.vrel = vel[j] - vi;
+      in.wi = wi;
+      in.wj = omega[j];
+      in.vrel_mid = vel_mid[j] - vi_mid;
+      in.wi_mid = wi_mid;
+      in.wj_mid = omega_mid[j];
+      const PairLaw& law = laws[material[j]];
       const PairOutput out =
           pair_contact<M, Resist>(law, in, PairSprings{pl.spring_t[k], pl.spring_r[k], pl.spring_w[k]}, dt);
-      F[i] += out.force_i;
+      fi += out.force_i;
+      ti += out.torque_i;
       F[j] -= out.force_i;
-      T[i] += out.torque_i;
       T[j] += out.torque_j;
-      ++sc.contacts;
+      ++contacts;
       if (s.log_contacts)
         sc.log.push_back({i, j, in.x, out.fn, out.ft.norm(), out.mr.norm(), std::fabs(out.mt), law.mu_s, law.mu_r,
                           law.mu_t, law.beta, in.reff});
       const double rmin = std::min(ri, rj);
-      if (in.x > sc.max_overlap_ratio * rmin) {
-        sc.max_overlap_ratio = in.x / rmin;
-        sc.max_overlap_grain = i;
+      if (in.x > max_ratio * rmin) {
+        max_ratio = in.x / rmin;
+        max_grain = i;
       }
     }
+    F[i] += fi;
+    T[i] += ti;
   }
+  sc.contacts += contacts;
+  sc.max_overlap_ratio = max_ratio;
+  sc.max_overlap_grain = max_grain;
 }
 
 // Grain–wall contacts of wall-list entries [kb, ke) into State::force.
@@ -118,6 +143,9 @@ void wall_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
     in.vrel = -s.vel[i];
     in.wi = s.omega[i];
     in.wj.setZero();
+    in.vrel_mid = -s.vel_mid[i];
+    in.wi_mid = s.omega_mid[i];
+    in.wj_mid.setZero();
     const PairLaw& law = m.law(m.grain_material[i], w.law_material);
     const PairOutput out =
         pair_contact<M, Resist>(law, in, PairSprings{wl.spring_t[k], wl.spring_r[k], wl.spring_w[k]}, dt);

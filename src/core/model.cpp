@@ -146,7 +146,10 @@ void finalize_model(Model& m) {
   for (int a = 0; a < nm; ++a)
     for (int b = 0; b < nm; ++b) {
       PairLaw L = make_law(m, m.materials[a], m.materials[b]);
-      if (m.contact_model == ContactModel::HertzMindlin && !(L.e_star > 0))
+      // A rigid structure (young = 0) needs an elastic partner; structure pairs
+      // (wall-wall) never use this table.
+      const bool grain_pair = !m.materials[a].structure || !m.materials[b].structure;
+      if (m.contact_model == ContactModel::HertzMindlin && grain_pair && !(L.e_star > 0))
         throw InputError("model: Hertz–Mindlin needs young > 0 for material '" + m.materials[a].name + "' or '" +
                          m.materials[b].name + "'");
       m.any_resistance = m.any_resistance || L.rolling || L.twisting;

@@ -9,6 +9,8 @@ State make_state(const Model& m) {
   s.pos.assign(n, Vec3::Zero());
   s.vel.assign(n, Vec3::Zero());
   s.omega.assign(n, Vec3::Zero());
+  s.vel_mid.assign(n, Vec3::Zero());
+  s.omega_mid.assign(n, Vec3::Zero());
   s.force.assign(n, Vec3::Zero());
   s.torque.assign(n, Vec3::Zero());
   s.pos_at_build.assign(n, Vec3::Zero());

@@ -11,7 +11,19 @@ namespace rt {
 
 void prime(const Model& m, State& s) {
   build_neighbour_lists(m, s);
+  // Forces of the current state without advancing any spring: the springs
+  // are put back after the pass.
+  s.vel_mid = s.vel;
+  s.omega_mid = s.omega;
+  const PairList springs = s.pairs;
+  const WallList wall_springs = s.wall_pairs;
   compute_forces(m, s);
+  s.pairs.spring_t = springs.spring_t;
+  s.pairs.spring_r = springs.spring_r;
+  s.pairs.spring_w = springs.spring_w;
+  s.wall_pairs.spring_t = wall_springs.spring_t;
+  s.wall_pairs.spring_r = wall_springs.spring_r;
+  s.wall_pairs.spring_w = wall_springs.spring_w;
 }
 
 void step(const Model& m, State& s) {
@@ -20,7 +32,7 @@ void step(const Model& m, State& s) {
   check_guards(m, s);
   if (lists_need_rebuild(m, s)) build_neighbour_lists(m, s);       // neighbours
   compute_forces(m, s);                                            // contacts -> forces
-  kick(m, s, 0.5 * m.dt);                                          // integrate: half kick
+  finish_kick(m, s, 0.5 * m.dt);                                   // integrate: half kick
   s.time += m.dt;
   ++s.step;
   check_guards(m, s);                                              // guards
@@ -38,7 +50,8 @@ void check_guards(const Model& m, const State& s) {
     std::ostringstream os;
     os << "numerical blow-up at step " << s.step << " (t = " << s.time << " s): overlap of grain "
        << st.max_overlap_grain << " reached " << st.max_overlap_ratio << " of its radius, beyond the limit "
-       << m.guards.max_overlap_ratio << " (guards.max_overlap_ratio); raise k_n or lower the impact speed";
+       << m.guards.max_overlap_ratio << " (guards.max_overlap_ratio); raise k_n, lower the impact speed or reduce dt "
+       << "(see the steps-per-contact report)";
     throw BlowUpError(os.str());
   }
 }

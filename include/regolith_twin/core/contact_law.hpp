@@ -20,8 +20,10 @@ struct PairInput {
   double li, lj;   // lever arms r - x/2, m
   double reff;     // effective radius R = r_i r_j / (r_i + r_j), m
   double sqrt_mstar;  // square root of the reduced mass, sqrt(kg)
-  Vec3 vrel;       // v_j - v_i, m/s
-  Vec3 wi, wj;     // angular velocities, rad/s
+  Vec3 vrel;       // v_j - v_i at the end of the step (predicted), m/s: dashpots
+  Vec3 wi, wj;     // angular velocities at the end of the step (predicted), rad/s: dashpots
+  Vec3 vrel_mid;   // v_j - v_i at mid-step, m/s: spring increments (consistent with the drift)
+  Vec3 wi_mid, wj_mid;  // angular velocities at mid-step, rad/s: spring increments
 };
 
 // Spring history of one pair (read and written by the law).
@@ -47,17 +49,19 @@ namespace detail {
 inline void rotate_into_plane(Vec3& s, const Vec3& n) {
   const double s2 = s.squaredNorm();
   if (s2 == 0.0) return;
-  s -= s.dot(n) * n;
-  const double p2 = s.squaredNorm();
+  const double sn = s.dot(n);
+  s -= sn * n;
+  const double p2 = s2 - sn * sn;  // |s|^2 after removing the normal part
   if (p2 > 0.0) s *= std::sqrt(s2 / p2);
 }
 
 // Spring–dashpot–slider update shared by sliding and rolling resistance:
-// add rate*dt, shorten the spring to the cap, scale the total (spring +
-// dashpot) to the cap without touching the spring. Returns k*s + c*rate.
+// add rate_mid*dt (the mid-step rate, as the positions move), shorten the
+// spring to the cap, scale the total (spring + dashpot on the end-of-step
+// rate) to the cap without touching the spring. Returns k*s + c*rate.
 // Magnitudes are compared squared, so a sticking contact takes no sqrt.
-inline Vec3 slider(Vec3& s, const Vec3& rate, double k, double c, double cap, double dt) {
-  s += rate * dt;
+inline Vec3 slider(Vec3& s, const Vec3& rate_mid, const Vec3& rate, double k, double c, double cap, double dt) {
+  s += rate_mid * dt;
   const double ks2 = k * k * s.squaredNorm();
   if (ks2 > cap * cap) s *= cap / std::sqrt(ks2);
   Vec3 f = k * s + c * rate;
@@ -67,8 +71,8 @@ inline Vec3 slider(Vec3& s, const Vec3& rate, double k, double c, double cap, do
 }
 
 // Scalar version for the twisting spring (kept along n).
-inline double slider1(double& s, double rate, double k, double c, double cap, double dt) {
-  s += rate * dt;
+inline double slider1(double& s, double rate_mid, double rate, double k, double c, double cap, double dt) {
+  s += rate_mid * dt;
   const double ks = k * std::fabs(s);
   if (ks > cap) s *= cap / ks;
   double m = k * s + c * rate;
@@ -112,10 +116,13 @@ inline PairOutput pair_contact(const PairLaw& law, const PairInput& in, PairSpri
   const LawTerms k = law_terms<M>(law, in.x, in.reff, in.sqrt_mstar);
   const Vec3& n = in.n;
 
-  // Relative velocity of the contact points and its normal / tangential parts.
+  // Relative velocity of the contact points and its normal / tangential
+  // parts: at the end of the step for the dashpots, at mid-step for springs.
   const Vec3 u = in.vrel - (in.lj * in.wj + in.li * in.wi).cross(n);
   const double un = u.dot(n);
   const Vec3 ut = u - un * n;
+  const Vec3 um = in.vrel_mid - (in.lj * in.wj_mid + in.li * in.wi_mid).cross(n);
+  const Vec3 ut_mid = um - um.dot(n) * n;
 
   // Normal force on i: spring pushes i away from j, damping opposes approach.
   PairOutput out;
@@ -124,7 +131,7 @@ inline PairOutput pair_contact(const PairLaw& law, const PairInput& in, PairSpri
 
   // Tangential spring with Coulomb limit.
   detail::rotate_into_plane(sp.s, n);
-  const Vec3 ft = detail::slider(sp.s, ut, k.kt, k.ct, law.mu_s * out.fn, dt);
+  const Vec3 ft = detail::slider(sp.s, ut_mid, ut, k.kt, k.ct, law.mu_s * out.fn, dt);
   out.force_i += ft;
   out.ft = ft;
   const Vec3 tq = n.cross(ft);
@@ -134,19 +141,19 @@ inline PairOutput pair_contact(const PairLaw& law, const PairInput& in, PairSpri
   if constexpr (Resist) {
     const double br = law.beta * in.reff;
     const double br2 = br * br;
-    const Vec3 wrel = in.wj - in.wi;
-    const double wn = wrel.dot(n);
+    const Vec3 wrel = in.wj - in.wi, wrel_mid = in.wj_mid - in.wi_mid;
+    const double wn = wrel.dot(n), wn_mid = wrel_mid.dot(n);
     if (law.rolling) {
-      const Vec3 wroll = wrel - wn * n;
+      const Vec3 wroll = wrel - wn * n, wroll_mid = wrel_mid - wn_mid * n;
       detail::rotate_into_plane(sp.roll, n);
-      const Vec3 mr = detail::slider(sp.roll, wroll, k.kn_eff * br2, k.cn * br2,
+      const Vec3 mr = detail::slider(sp.roll, wroll_mid, wroll, k.kn_eff * br2, k.cn * br2,
                                      law.mu_r * br * out.fn, dt);
       out.torque_i += mr;
       out.torque_j -= mr;
       out.mr = mr;
     }
     if (law.twisting) {
-      const double mt = detail::slider1(sp.twist, wn, 2.0 * k.kt * br2, 2.0 * k.ct * br2,
+      const double mt = detail::slider1(sp.twist, wn_mid, wn, 2.0 * k.kt * br2, 2.0 * k.ct * br2,
                                         law.mu_t * br * law.mu_s * out.fn, dt);
       out.torque_i += mt * n;
       out.torque_j -= mt * n;

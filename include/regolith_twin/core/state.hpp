@@ -75,6 +75,8 @@ struct State {
   std::vector<Vec3> pos;        // grain centre, m (n_grains)
   std::vector<Vec3> vel;        // velocity, m/s
   std::vector<Vec3> omega;      // angular velocity, rad/s
+  std::vector<Vec3> vel_mid;    // mid-step velocity v(n+1/2) while vel holds the predicted v(n+1), m/s
+  std::vector<Vec3> omega_mid;  // mid-step angular velocity, rad/s
   std::vector<Vec3> force;      // total force of the last force pass, N
   std::vector<Vec3> torque;     // total torque of the last force pass, N m
 

@@ -26,9 +26,7 @@ def plot_convergence(rows, out):
     pairs = ["grain-grain", "grain-wall"]
     # The eps_n of the assertions (the CSV may hold more).
     eps_values = [e for e in (0.1, 0.5, 0.9, 1.0) if any(float(r["eps_n"]) == e for r in rows)]
-    schemes = [s for s in ("engine", "predictor") if any(r["scheme"] == s for r in rows)]
     colours = ["tab:red", "tab:blue", "tab:green", "tab:purple"]
-    style = {"engine": "-o", "predictor": "--s"}
     fig, axes = plt.subplots(2, 2, figsize=(12, 9.5), sharex=True)
     floor = 1e-12
     for col, pair in enumerate(pairs):
@@ -37,16 +35,13 @@ def plot_convergence(rows, out):
              ("mean_error", "|phase-mean eps - eps_n| / eps_n")]):
             ax = axes[row][col]
             for colour, eps in zip(colours, eps_values):
-                for scheme in schemes:
-                    sel = [r for r in rows if r["pair"] == pair and r["scheme"] == scheme
-                           and float(r["eps_n"]) == eps]
-                    sel.sort(key=lambda r: float(r["N"]))
-                    n = [float(r["N"]) for r in sel]
-                    err = [max(abs(float(r[key])), floor) for r in sel]
-                    if not n or max(err) <= floor:
-                        continue
-                    ax.loglog(n, err, style[scheme], color=colour, ms=4, lw=1.3,
-                              label=f"eps_n={eps:g} ({scheme})")
+                sel = [r for r in rows if r["pair"] == pair and float(r["eps_n"]) == eps]
+                sel.sort(key=lambda r: float(r["N"]))
+                n = [float(r["N"]) for r in sel]
+                err = [max(abs(float(r[key])), floor) for r in sel]
+                if not n or max(err) <= floor:
+                    continue
+                ax.loglog(n, err, "-o", color=colour, ms=4, lw=1.3, label=f"eps_n={eps:g}")
             # Reference slopes through a visible point.
             n_ref = [8, 240]
             ax.loglog(n_ref, [0.2 * (8 / x) for x in n_ref], "k-", lw=2.2, alpha=0.45, label="slope -1")
@@ -61,10 +56,10 @@ def plot_convergence(rows, out):
             if col == 0:
                 ax.set_ylabel("relative restitution error")
     handles, labels = axes[1][0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=5, fontsize=9, frameon=False)
-    fig.suptitle("Linear law: measured normal restitution vs steps per contact "
-                 "(engine = rt::step, predictor = forces at predicted v(n+1))", fontsize=11)
-    fig.tight_layout(rect=(0, 0.09, 1, 0.96))
+    fig.legend(handles, labels, loc="lower center", ncol=6, fontsize=9, frameon=False)
+    fig.suptitle("Linear law: measured normal restitution vs steps per contact (rt::step, "
+                 f"{rows[0]['phases']} entry phases per point)", fontsize=11)
+    fig.tight_layout(rect=(0, 0.05, 1, 0.96))
     fig.savefig(out, dpi=110)
     plt.close(fig)
 

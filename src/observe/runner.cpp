@@ -124,7 +124,6 @@ RunReport run_scenario(const Scenario& sc, State& s, const RunOptions& opt) {
   auto last_progress = t0;
   const double t_start = s.time;
   double next_sample = s.time;
-  double elapsed_stages = 0;
 
   try {
     for (size_t k = 0; k < sc.stages.size(); ++k) {
@@ -146,7 +145,7 @@ RunReport run_scenario(const Scenario& sc, State& s, const RunOptions& opt) {
           held_pos.push_back(s.pos[i]);
         }
       }
-      const double t_stage0 = s.time, t_stage1 = s.time + st.duration;
+      const double t_stage1 = s.time + st.duration;
       double next_check = s.time + st.check_every;
       StageReport sr{st.name, 0, "duration"};
       while (s.time < t_stage1 - 0.5 * m.dt) {
@@ -175,18 +174,19 @@ RunReport run_scenario(const Scenario& sc, State& s, const RunOptions& opt) {
           if (std::chrono::duration<double>(now - last_progress).count() >= opt.progress_every) {
             last_progress = now;
             const double wall = std::chrono::duration<double>(now - t0).count();
-            const double done = elapsed_stages + (s.time - t_stage0);
+            // Remaining: this stage's rest plus the later stages (at most).
+            double left = t_stage1 - s.time;
+            for (size_t q = k + 1; q < sc.stages.size(); ++q) left += sc.stages[q].duration;
             const double rate = (s.time - t_start) / std::max(wall, 1e-9);
             const double steps_s = double(s.step) / std::max(wall, 1e-9);
             std::fprintf(stderr, "[%s] stage %zu/%zu '%s'  t = %.4g s of %.4g s  %.3g steps/s  %.3g grain-steps/s  ETA %s\n",
                          sc.name.c_str(), k + 1, sc.stages.size(), st.name.c_str(), s.time, total_time, steps_s,
-                         steps_s * m.n_grains, clock_text((total_time - done) / std::max(rate, 1e-300)).c_str());
+                         steps_s * m.n_grains, clock_text(left / std::max(rate, 1e-300)).c_str());
           }
         }
       }
       sr.t_end = s.time;
       rep.stages.push_back(sr);
-      elapsed_stages += s.time - t_stage0;
     }
     if (write) sample();
   } catch (const BlowUpError& e) {

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -18,8 +19,6 @@
 namespace rv = rt::validate;
 
 namespace {
-
-const char* scheme_name(rv::Scheme s) { return s == rv::Scheme::Engine ? "engine" : "predictor"; }
 
 FILE* open_csv(const std::filesystem::path& dir, const char* name, const char* header) {
   const auto path = dir / name;
@@ -47,42 +46,39 @@ int main(int argc, char** argv) {
     const std::vector<double> eps_list = {0.1, 0.3, 0.5, 0.7, 0.9, 1.0};
     const std::vector<double> Ns = rv::convergence_steps();
     FILE* fc = open_csv(dir, "restitution_convergence.csv",
-                        "pair,scheme,eps_n,N,steps_per_contact,phases,eps_mean,eps_min,eps_max,"
+                        "pair,eps_n,N,steps_per_contact,phases,eps_mean,eps_min,eps_max,"
                         "mean_error,mean_abs_error,worst_abs_error");
     FILE* fd = open_csv(dir, "contact_duration.csv",
-                        "pair,scheme,eps_n,N,t_contact_s,dt_s,steps_per_contact,worst_duration_error_steps,"
+                        "pair,eps_n,N,t_contact_s,dt_s,steps_per_contact,worst_duration_error_steps,"
                         "max_overlap_over_xmax");
-    FILE* fs = open_csv(dir, "convergence_slopes.csv", "pair,scheme,eps_n,slope,mean_abs_error_N30");
+    FILE* fs = open_csv(dir, "convergence_slopes.csv", "pair,eps_n,slope,mean_abs_error_N30");
     std::printf("linear law, %d entry phases per point (relative errors in %%)\n", phases);
-    std::printf("%-11s %-9s %5s %6s | %9s %9s %9s | %9s %7s\n", "pair", "scheme", "eps", "N", "mean err",
-                "worst", "mean|err|", "dur/dt", "x/xmax");
-    for (rv::Scheme scheme : {rv::Scheme::Engine, rv::Scheme::Predictor})
-      for (rv::PairKind kind : {rv::PairKind::GrainGrain, rv::PairKind::GrainWall})
-        for (double eps : eps_list) {
-          std::vector<double> errs;
-          double err30 = 0;
-          for (double N : Ns) {
-            const rv::PhaseSweep ps = rv::sweep_phases(kind, eps, N, phases, scheme);
-            std::fprintf(fc, "%s,%s,%.2f,%g,%.4f,%d,%.10f,%.10f,%.10f,%.6e,%.6e,%.6e\n", rv::pair_kind_name(kind),
-                         scheme_name(scheme), eps, N, ps.steps_per_contact, phases, ps.eps_mean, ps.eps_min,
-                         ps.eps_max, ps.mean_error, ps.mean_abs_error, ps.worst_abs_error);
-            std::fprintf(fd, "%s,%s,%.2f,%g,%.6e,%.6e,%.4f,%.4f,%.6f\n", rv::pair_kind_name(kind),
-                         scheme_name(scheme), eps, N, ps.t_contact, ps.dt, ps.steps_per_contact,
-                         ps.worst_duration_error, ps.max_overlap_ratio);
-            errs.push_back(std::max(ps.mean_abs_error, rv::kRoundingLevel));
-            if (N == 30) {
-              err30 = ps.mean_abs_error;
-              std::printf("%-11s %-9s %5.2f %6g | %9.4f %9.4f %9.4f | %9.3f %7.4f\n", rv::pair_kind_name(kind),
-                          scheme_name(scheme), eps, N, 100 * ps.mean_error, 100 * ps.worst_abs_error,
-                          100 * ps.mean_abs_error, ps.worst_duration_error, ps.max_overlap_ratio);
-            }
+    std::printf("%-11s %5s %6s | %9s %9s %9s | %9s %7s\n", "pair", "eps", "N", "mean err", "worst", "mean|err|",
+                "dur/dt", "x/xmax");
+    for (rv::PairKind kind : {rv::PairKind::GrainGrain, rv::PairKind::GrainWall})
+      for (double eps : eps_list) {
+        std::vector<double> errs;
+        double err30 = 0;
+        for (double N : Ns) {
+          const rv::PhaseSweep ps = rv::sweep_phases(kind, eps, N, phases);
+          std::fprintf(fc, "%s,%.2f,%g,%.4f,%d,%.10f,%.10f,%.10f,%.6e,%.6e,%.6e\n", rv::pair_kind_name(kind), eps, N,
+                       ps.steps_per_contact, phases, ps.eps_mean, ps.eps_min, ps.eps_max, ps.mean_error,
+                       ps.mean_abs_error, ps.worst_abs_error);
+          std::fprintf(fd, "%s,%.2f,%g,%.6e,%.6e,%.4f,%.4f,%.6f\n", rv::pair_kind_name(kind), eps, N, ps.t_contact,
+                       ps.dt, ps.steps_per_contact, ps.worst_duration_error, ps.max_overlap_ratio);
+          errs.push_back(std::max(ps.mean_abs_error, rv::kRoundingLevel));
+          if (N == 30) {
+            err30 = ps.mean_abs_error;
+            std::printf("%-11s %5.2f %6g | %9.4f %9.4f %9.4f | %9.3f %7.4f\n", rv::pair_kind_name(kind), eps, N,
+                        100 * ps.mean_error, 100 * ps.worst_abs_error, 100 * ps.mean_abs_error,
+                        ps.worst_duration_error, ps.max_overlap_ratio);
           }
-          const double slope = rv::loglog_slope(Ns, errs);
-          std::fprintf(fs, "%s,%s,%.2f,%.4f,%.6e\n", rv::pair_kind_name(kind), scheme_name(scheme), eps, slope,
-                       err30);
-          std::printf("%-11s %-9s %5.2f  slope of mean |error| vs N over %g..%g: %.3f\n", rv::pair_kind_name(kind),
-                      scheme_name(scheme), eps, Ns.front(), Ns.back(), slope);
         }
+        const double slope = rv::loglog_slope(Ns, errs);
+        std::fprintf(fs, "%s,%.2f,%.4f,%.6e\n", rv::pair_kind_name(kind), eps, slope, err30);
+        std::printf("%-11s %5.2f  slope of mean |error| vs N over %g..%g: %.3f\n", rv::pair_kind_name(kind), eps,
+                    Ns.front(), Ns.back(), slope);
+      }
     std::fclose(fc);
     std::fclose(fd);
     std::fclose(fs);

@@ -6,9 +6,6 @@
 #include <limits>
 #include <stdexcept>
 
-#include "regolith_twin/core/forces.hpp"
-#include "regolith_twin/core/integrate.hpp"
-#include "regolith_twin/core/neighbours.hpp"
 #include "regolith_twin/core/step.hpp"
 #include "regolith_twin/core/walls.hpp"
 
@@ -18,11 +15,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 double sphere_mass(double r, double density) { return 4.0 / 3.0 * kPi * r * r * r * density; }
-
-void advance(const Model& m, State& s, Scheme scheme) {
-  (void)scheme;
-  step(m, s);
-}
 
 // Contacts (grain–grain and grain–wall) found by the last force pass.
 long live_contacts(const State& s) { return s.stats.contacts + s.stats.wall_contacts; }
@@ -85,7 +77,7 @@ LinearImpactOutcome run_linear_impact(const LinearImpactSetup& c) {
   const long budget = long(10 * out.t_contact / out.dt) + 100;
   long first = -1, last = -1;
   for (long k = 0; k < budget; ++k) {
-    advance(m, s, c.scheme);
+    step(m, s);
     const double x = wall ? r - s.pos[0].x() : 2 * r - (s.pos[1].x() - s.pos[0].x());
     if (live_contacts(s) > 0) {
       if (first < 0) first = k;
@@ -103,10 +95,9 @@ LinearImpactOutcome run_linear_impact(const LinearImpactSetup& c) {
   return out;
 }
 
-PhaseSweep sweep_phases(PairKind kind, double eps_n, double steps, int n_phases, Scheme scheme) {
+PhaseSweep sweep_phases(PairKind kind, double eps_n, double steps, int n_phases) {
   PhaseSweep ps;
   ps.kind = kind;
-  ps.scheme = scheme;
   ps.eps_n = eps_n;
   ps.steps = steps;
   ps.n_phases = n_phases;
@@ -119,7 +110,6 @@ PhaseSweep sweep_phases(PairKind kind, double eps_n, double steps, int n_phases,
     c.eps_n = eps_n;
     c.steps = steps;
     c.phase = (p + 0.5) / n_phases;
-    c.scheme = scheme;
     const LinearImpactOutcome o = run_linear_impact(c);
     ps.t_contact = o.t_contact;
     ps.dt = o.dt;
@@ -344,7 +334,7 @@ HertzImpactOutcome run_hertz_impact(const HertzImpactSetup& c) {
   long contact_steps = 0;
   bool touched = false;
   for (long k = 0; k < budget; ++k) {
-    advance(m, s, c.scheme);
+    step(m, s);
     if (live_contacts(s) > 0) {
       touched = true;
       ++contact_steps;
@@ -422,7 +412,7 @@ RestitutionRow chung_ooi_test3(double e_in, double steps_per_contact) {
   return row;
 }
 
-ObliqueRow chung_ooi_test4(double angle_deg, double steps_per_contact, Scheme scheme) {
+ObliqueRow chung_ooi_test4(double angle_deg, double steps_per_contact) {
   const ElasticMaterial mat = chung_ooi_aluminium_oxide();
   const double v = kTest4Speed, mu = kTest4Friction, e = kTest4Restitution, R = kTest4Radius;
   HertzImpactSetup c;
@@ -434,7 +424,6 @@ ObliqueRow chung_ooi_test4(double angle_deg, double steps_per_contact, Scheme sc
   c.restitution = e;
   c.mu = mu;
   c.steps_per_contact = steps_per_contact;
-  c.scheme = scheme;
   const HertzImpactOutcome o = run_hertz_impact(c);
 
   ObliqueRow row;

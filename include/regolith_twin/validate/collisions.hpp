@@ -8,9 +8,8 @@
 //  * the damping prefactor of the Hertz–Mindlin law that reproduces a given
 //    coefficient of restitution exactly (a root find on the dimensionless
 //    contact equation).
-// Every case builds an ordinary Model/State and advances it with rt::step()
-// (Scheme::Engine), so these functions exercise the engine exactly as a scene
-// does; Scheme::Predictor runs the same case with step_velocity_predictor().
+// Every case builds an ordinary Model/State and advances it with rt::step(),
+// so these functions exercise the engine exactly as a scene does.
 #pragma once
 
 #include <string>
@@ -20,19 +19,6 @@
 #include "regolith_twin/core/state.hpp"
 
 namespace rt::validate {
-
-// ---------------------------------------------------------------------------
-// Time integration used by a verification case.
-enum class Scheme {
-  Engine,     // rt::step(): kick–drift–kick, forces evaluated with v(n+1/2)
-  Predictor,  // kick–drift–kick with forces evaluated at the predicted
-              // full-step velocity v(n+1/2) + dt/2 a(n) (proposed core change)
-};
-
-// One kick–drift–kick step whose contact forces see the predicted velocity
-// v* = v(n+1/2) + dt/2 F(n)/m (and likewise for spin) instead of v(n+1/2).
-// Same stages, guards and bookkeeping as rt::step().
-void step_velocity_predictor(const Model& m, State& s);
 
 // ---------------------------------------------------------------------------
 // Linear normal collision (MODEL.md §2, §4).
@@ -48,7 +34,6 @@ struct LinearImpactSetup {
   double density = 2500;     // kg/m^3
   double speed = 1.0;        // impact relative normal speed, m/s
   double xmax_fraction = 0.01;  // x_max / radius in k_n = m_p (v / x_max)^2
-  Scheme scheme = Scheme::Engine;
 };
 
 struct LinearImpactOutcome {
@@ -68,7 +53,6 @@ LinearImpactOutcome run_linear_impact(const LinearImpactSetup& setup);
 // Statistics over n_phases uniformly spaced entry phases (p + 1/2) / n_phases.
 struct PhaseSweep {
   PairKind kind = PairKind::GrainGrain;
-  Scheme scheme = Scheme::Engine;
   double eps_n = 0, steps = 0;
   int n_phases = 0;
   double t_contact = 0, dt = 0;    // analytic duration and step, s
@@ -82,8 +66,7 @@ struct PhaseSweep {
   bool all_ended = true;
 };
 
-PhaseSweep sweep_phases(PairKind kind, double eps_n, double steps, int n_phases,
-                        Scheme scheme = Scheme::Engine);
+PhaseSweep sweep_phases(PairKind kind, double eps_n, double steps, int n_phases);
 
 // Steps per contact N used by the convergence study: 8 ... 240, roughly
 // log-spaced, always containing 30 (the engine default).
@@ -139,7 +122,6 @@ struct HertzImpactSetup {
   double mu = 0.0;              // sliding friction
   double steps_per_contact = 500;  // dt = Hertz contact time / this
   double damping_prefactor = -1;   // >= 0 overrides the law's alpha (calibrated runs)
-  Scheme scheme = Scheme::Engine;
 };
 
 struct HertzImpactOutcome {
@@ -196,8 +178,7 @@ struct ObliqueRow {
   bool slid_throughout = false; // the friction force sat at the Coulomb limit at every contact step
   double steps_per_contact = 0;
 };
-ObliqueRow chung_ooi_test4(double angle_deg, double steps_per_contact = 500,
-                           Scheme scheme = Scheme::Engine);
+ObliqueRow chung_ooi_test4(double angle_deg, double steps_per_contact = 500);
 constexpr double kTest4Speed = 3.9;      // m/s
 constexpr double kTest4Friction = 0.092;
 constexpr double kTest4Restitution = 0.98;

@@ -25,24 +25,6 @@ namespace {
 
 using rt::Vec3;
 
-// Spinning OpenMP threads starve each other when the machine's cores are
-// shared with other jobs (2-thread runs of this scene then took ~10x longer
-// than serial ones). libgomp reads OMP_WAIT_POLICY once, when it is loaded,
-// so unless the caller chose a policy this binary restarts itself with
-// passive waiting before any test runs. Results do not depend on it.
-[[maybe_unused]] const bool kRestartedWithPassiveWait = [] {
-  if (std::getenv("OMP_WAIT_POLICY")) return false;
-  std::ifstream f("/proc/self/cmdline", std::ios::binary);
-  std::string args((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  std::vector<char*> argv;
-  for (size_t p = 0; p < args.size(); p += std::strlen(&args[p]) + 1) argv.push_back(&args[p]);
-  if (argv.empty()) return false;
-  argv.push_back(nullptr);
-  setenv("OMP_WAIT_POLICY", "passive", 1);
-  execv("/proc/self/exe", argv.data());
-  return false;  // exec failed: carry on with the default policy
-}();
-
 constexpr int kGrains = 4000;
 constexpr int kSteps = 10000;
 

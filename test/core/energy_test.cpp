@@ -25,13 +25,7 @@
 
 namespace {
 
-// A figure for the test report (gtest XML property).
-std::string figure(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
-
+using rt::test::figure;
 using rt::Vec3;
 
 constexpr double kPi = 3.14159265358979323846;

@@ -1,12 +1,17 @@
 // Helpers shared by the engine tests: small models built in code.
 #pragma once
 
+#include <string>
+
 #include "regolith_twin/core/energy.hpp"
 #include "regolith_twin/core/model.hpp"
 #include "regolith_twin/core/state.hpp"
 #include "regolith_twin/core/step.hpp"
 
 namespace rt::test {
+
+// A figure for the test report (gtest XML property), 4 significant digits.
+std::string figure(double v);
 
 // A material with the given restitution and friction (no rolling/twisting).
 Material simple_material(const std::string& name, double density, double eps_n, double eps_t, double mu_s);

@@ -164,8 +164,10 @@ std::vector<PairResolution> pair_resolution(const Model& m, double v_ref) {
   // Smallest grain of each material.
   const int nm = m.n_materials();
   std::vector<double> mmin(nm, 0), rmin(nm, 0);
+  std::vector<long> count(nm, 0);
   for (int i = 0; i < m.n_grains; ++i) {
     const int a = m.grain_material[i];
+    ++count[a];
     if (mmin[a] == 0 || m.grain_mass[i] < mmin[a]) {
       mmin[a] = m.grain_mass[i];
       rmin[a] = m.grain_radius[i];
@@ -178,7 +180,7 @@ std::vector<PairResolution> pair_resolution(const Model& m, double v_ref) {
   for (int a = 0; a < nm; ++a) {
     if (mmin[a] == 0) continue;
     for (int b = a; b < nm; ++b) {
-      if (mmin[b] == 0) continue;
+      if (mmin[b] == 0 || (a == b && count[a] < 2)) continue;  // no such pair in the scene
       const double ms = mmin[a] * mmin[b] / (mmin[a] + mmin[b]);
       const double re = rmin[a] * rmin[b] / (rmin[a] + rmin[b]);
       const double tc = time_of(m.law(a, b), ms, re, m.law(a, b).eps_n);

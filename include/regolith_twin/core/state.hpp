@@ -48,7 +48,7 @@ struct ContactRecord {
   double mu_s, mu_r, mu_t, beta, reff;  // law constants of the pair
 };
 
-// Per-thread accumulators of one force pass (merged in thread order).
+// Accumulators of one work partition of the force pass (merged in partition order).
 struct ThreadScratch {
   std::vector<Vec3> force;      // force on grains, N (thread 0 writes State::force)
   std::vector<Vec3> torque;     // torque, N m

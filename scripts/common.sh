@@ -11,7 +11,7 @@ export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
 export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
 
 # Debian packages the build and tests need.
-BUILD_PACKAGES=(g++ make cmake catkin libeigen3-dev libyaml-cpp-dev googletest python3)
+BUILD_PACKAGES=(g++ make cmake pkg-config catkin libeigen3-dev libyaml-cpp-dev libbullet-dev liburdfdom-dev googletest python3)
 # Extra packages for reports (plots).
 REPORT_PACKAGES=(python3-numpy python3-matplotlib)
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "regolith_twin/core/body.hpp"
 #include "regolith_twin/core/types.hpp"
 
 namespace rt {
@@ -104,6 +105,7 @@ struct Model {
 
   // --- environment ---
   std::vector<Wall> walls;
+  std::vector<BodyModel> bodies;       // rigid bodies (MODEL.md §6)
   Vec3 gravity = Vec3(0, 0, -9.81);    // m/s^2
 
   // --- integration ---

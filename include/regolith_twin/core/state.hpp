@@ -37,6 +37,35 @@ struct WallList {
   int size() const { return static_cast<int>(grain.size()); }
 };
 
+// Grain–body candidates within r_i + skin of a body shape, sorted by
+// (grain, body, shape), with history.
+struct BodyGrainList {
+  std::vector<int> grain;       // grain index of each entry
+  std::vector<int> body;        // body index
+  std::vector<int> shape;       // shape index within the body
+  std::vector<double> sqrt_mstar;  // sqrt(m_i M / (m_i + M)), sqrt(kg)
+  std::vector<Vec3> spring_t;   // tangential spring, m
+  std::vector<Vec3> spring_r;   // rolling spring, rad
+  std::vector<double> spring_w; // twisting spring, rad
+  std::vector<uint8_t> touching;
+  int size() const { return static_cast<int>(grain.size()); }
+};
+
+// Contact point between two bodies with its tangential history. Points are
+// identified from step to step by their position on each body (body frames),
+// as a persistent contact manifold does.
+struct BodyPointContact {
+  int a = 0, b = 0;             // bodies, a < b
+  int shape_a = 0, shape_b = 0; // shapes of a and b
+  Vec3 local_a = Vec3::Zero();  // contact point on a, a's body frame, m
+  Vec3 local_b = Vec3::Zero();  // contact point on b, b's body frame, m
+  Vec3 spring_t = Vec3::Zero(); // tangential spring, m
+  double overlap = 0;           // penetration depth at the last force pass, m
+  Vec3 normal = Vec3::UnitZ();  // unit normal from a to b at the last force pass (world)
+  Vec3 point = Vec3::Zero();    // contact point at the last force pass (world), m
+  Vec3 force_a = Vec3::Zero();  // force on a at the last force pass, N
+};
+
 // One evaluated contact, recorded only while State::log_contacts is set
 // (verification and diagnostics; the normal step records nothing).
 struct ContactRecord {
@@ -57,6 +86,8 @@ struct ThreadScratch {
   int max_overlap_grain = -1;
   long contacts = 0;
   std::vector<ContactRecord> log;  // filled only while State::log_contacts
+  std::vector<Vec3> body_force;    // grain–body reaction on each body, N (n_bodies)
+  std::vector<Vec3> body_torque;   // about each body's centre of mass, N m
 };
 
 struct StepStats {
@@ -64,6 +95,8 @@ struct StepStats {
   int max_overlap_grain = -1;    // a grain of the contact with that overlap
   long contacts = 0;             // grain–grain contacts with overlap > 0
   long wall_contacts = 0;        // grain–wall contacts with overlap > 0
+  long body_contacts = 0;        // grain–body contacts with overlap > 0
+  long body_body_contacts = 0;   // body–body contact points
   bool finite = true;            // every velocity finite after the last kick
   double max_disp2 = 0;          // squared max displacement since the last list build, m^2
 };
@@ -79,6 +112,8 @@ struct State {
   std::vector<Vec3> omega_mid;  // mid-step angular velocity, rad/s
   std::vector<Vec3> force;      // total force of the last force pass, N
   std::vector<Vec3> torque;     // total torque of the last force pass, N m
+
+  std::vector<BodyState> bodies;  // rigid bodies (n_bodies)
 
   std::vector<uint8_t> wall_on;  // 1 while wall w takes part (a lifted cylinder is 0) (n_walls)
 
@@ -100,6 +135,12 @@ struct State {
   std::vector<int> cell_start, cell_items, cell_of;
   PairList pairs_next;              // double buffer for rebuilds
   WallList wall_pairs_next;
+
+  // Grain–body candidates and body–body contact points with their history.
+  BodyGrainList body_grains, body_grains_next;
+  double body_list_grain_disp = 0;  // max grain displacement (since pos_at_build) when body_grains was built, m
+  long body_rebuilds = 0;
+  std::vector<BodyPointContact> body_points, body_points_next;
 
   StepStats stats;
   bool log_contacts = false;  // record every contact of each force pass in scratch[p].log

@@ -225,16 +225,7 @@ void build_body_grains(const Model& m, State& s) {
     s.bodies[b].q_at_build = s.bodies[b].q;
   }
   s.body_list_grain_disp = std::sqrt(s.stats.max_disp2);
-  // Entries split at grain boundaries into the fixed partitions.
-  const int P = m.partitions;
-  s.thread_body_begin.resize(P + 1);
-  const BodyGrainList& bl = s.body_grains;
-  for (int p = 0; p <= P; ++p) {
-    int k = int(long(bl.size()) * p / P);
-    while (k > 0 && k < bl.size() && bl.grain[k] == bl.grain[k - 1]) ++k;
-    s.thread_body_begin[p] = k;
-  }
-  for (int p = 1; p <= P; ++p) s.thread_body_begin[p] = std::max(s.thread_body_begin[p], s.thread_body_begin[p - 1]);
+  partition_body_list(m, s);
   ++s.body_rebuilds;
 }
 
@@ -256,6 +247,19 @@ bool body_list_needs_rebuild(const Model& m, const State& s) {
   // A gap can close by at most the grain's plus the body's displacement since
   // the build; grains are measured from pos_at_build (triangle inequality).
   return std::sqrt(s.stats.max_disp2) + s.body_list_grain_disp + max_body_displacement(m, s) > m.skin;
+}
+
+void partition_body_list(const Model& m, State& s) {
+  // Entries split at grain boundaries into the fixed partitions.
+  const int P = m.partitions;
+  s.thread_body_begin.resize(P + 1);
+  const BodyGrainList& bl = s.body_grains;
+  for (int p = 0; p <= P; ++p) {
+    int k = int(long(bl.size()) * p / P);
+    while (k > 0 && k < bl.size() && bl.grain[k] == bl.grain[k - 1]) ++k;
+    s.thread_body_begin[p] = k;
+  }
+  for (int p = 1; p <= P; ++p) s.thread_body_begin[p] = std::max(s.thread_body_begin[p], s.thread_body_begin[p - 1]);
 }
 
 void build_body_list(const Model& m, State& s) { build_body_grains(m, s); }

@@ -19,6 +19,9 @@ void build_neighbour_lists(const Model& m, State& s);
 // lists, and on its own when only bodies moved (a fast impactor).
 bool body_list_needs_rebuild(const Model& m, const State& s);
 void build_body_list(const Model& m, State& s);
+// Split the grain–body entries into the fixed work partitions (done by every
+// build; needed again after a checkpoint restores the list).
+void partition_body_list(const Model& m, State& s);
 
 // Recompute the per-entry constants and the fixed work partition of the
 // current lists (done by every build; needed again only after lists are

@@ -135,6 +135,14 @@ RunReport run_scenario(Scenario& sc, State& s, const RunOptions& opt) {
         removed = remove_grains(sc, s, drop);
         held.assign(m.n_grains, 0);
       }
+      if (st.stiffness_scale > 0 && sc.scene_kn > 0) {
+        // Same steps per contact at the new stiffness. Live springs keep their
+        // extension; the law table is rebuilt for the new k_n.
+        sc.model.kn = sc.scene_kn * st.stiffness_scale;
+        sc.model.dt = sc.scene_dt / std::sqrt(st.stiffness_scale);
+        finalize_model(sc.model);
+        s.forces_valid = false;
+      }
       const Vec3 g_from = m.gravity;
       if (st.set_gravity && st.gravity_ramp <= 0) sc.model.gravity = st.gravity;
       const double t_ramp0 = s.time;

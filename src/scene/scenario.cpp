@@ -683,6 +683,8 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   m.guards.allow_under_resolved = rd.boolean(gd, "guards", "allow_under_resolved", false);
 
   finalize_model(m);
+  sc.scene_kn = m.kn;
+  sc.scene_dt = m.dt;
 
   // Resolution report: warn below 10 steps per contact, refuse below 4.
   sc.resolution = pair_resolution(m, sc.v_ref);
@@ -711,7 +713,7 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
       const std::string p = "stages[" + std::to_string(i) + "]";
       rd.only(st[i], p,
               {"name", "duration", "hold", "remove_walls", "until_rms_speed", "until_max_speed", "check_every",
-               "gravity", "gravity_ramp", "trim_above"});
+               "gravity", "gravity_ramp", "trim_above", "stiffness_scale"});
       Stage s;
       s.name = rd.text(st[i], p, "name", "stage" + std::to_string(i));
       s.duration = rd.number(st[i], p, "duration", 0, 0, 1e9, true);
@@ -743,6 +745,7 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
       }
       s.gravity_ramp = rd.number(st[i], p, "gravity_ramp", 0, 0, s.duration);
       if (s.gravity_ramp > 0 && !s.set_gravity) rd.fail(p + ".gravity_ramp", "needs a 'gravity' to ramp to");
+      s.stiffness_scale = rd.number(st[i], p, "stiffness_scale", 0, 0, 1);
       if (st[i]["trim_above"]) {
         s.trim = true;
         s.trim_above = rd.number(st[i], p, "trim_above", 0, -kInf, kInf);
@@ -766,6 +769,19 @@ Scenario parse_scenario_text(const std::string& yaml_text, const std::string& so
     throw InputError(source + ": not valid YAML: " + e.what());
   }
   return parse_scenario(root, source);
+}
+
+YAML::Node load_document(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open scenario file");
+  YAML::Node root;
+  try {
+    root = YAML::Load(in);
+  } catch (const YAML::Exception& e) {
+    throw InputError(path + ": not valid YAML: " + e.what());
+  }
+  for (const auto& o : overrides) apply_override(root, o);
+  return root;
 }
 
 Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides) {

@@ -35,6 +35,8 @@ struct Stage {
   bool set_gravity = false;           // change gravity at the start of the stage
   Vec3 gravity = Vec3::Zero();        // new gravity, m/s^2
   double gravity_ramp = 0;            // s over which gravity moves geometrically to the new value (0: at once)
+  double stiffness_scale = 0;         // > 0: k_n of this stage = scale * the scene's, dt = scene dt / sqrt(scale)
+                                      //      (softer springs for bed preparation); 0: keep the current values
   bool trim = false;                  // remove grains at the start of the stage
   double trim_above = 0;              // ... whose centre lies above this height (z), m
 };
@@ -51,12 +53,17 @@ struct Scenario {
   double v_ref = 1.0;                 // reference impact speed for resolution reports, m/s
   std::vector<PairResolution> resolution;  // steps per contact of every pair type
   std::vector<std::string> warnings;  // non-fatal remarks (under-resolved contacts, ...)
+  double scene_kn = 0, scene_dt = 0;  // k_n and dt as parsed (stages may scale the model's)
   const GrainGroup* group(const std::string& name) const;
 };
 
 // Read a scenario file. `overrides` are "dotted.key=yaml-value" strings applied
 // to the document before it is interpreted (command-line --set).
 Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// Read a YAML document and apply "dotted.key=yaml-value" overrides, for tools
+// that take extra top-level blocks out before parse_scenario.
+YAML::Node load_document(const std::string& path, const std::vector<std::string>& overrides = {});
 
 // Interpret an already parsed document; `source` names it in error messages.
 Scenario parse_scenario(const YAML::Node& root, const std::string& source);

@@ -1,0 +1,109 @@
+// Lander scenes (SCENARIOS.md A): placing the lander for an attitude, impact
+// angle and speed; perturbed beds; and the landing outcome with the published
+// definitions (trim plane, run end, ballistic extrapolation, corners).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "regolith_twin/core/state.hpp"
+
+namespace YAML {
+class Node;
+}
+
+namespace rt {
+
+enum class Attitude { Flat, BCF, FCF };
+
+struct LandingSpec {
+  std::string lander;            // name of the lander body
+  double rim = 0.30;             // trim plane height (z), m: the surface reference
+  double container_radius = 0.75;  // m (far-field ring and perturbation)
+  Attitude attitude = Attitude::BCF;
+  double pitch_deg = 20;         // corner tilts: about the horizontal axis normal to the motion, deg
+  double roll_deg = 10;          // ... and about the direction of motion, deg (a corner, not an edge, first)
+  double angle_deg = 30;         // impact angle from the vertical (trim-plane normal), deg
+  double heading_deg = 0;        // direction of horizontal motion (azimuth about z), deg
+  double speed = 0.19;           // impact speed, m/s
+  double clearance = 0.002;      // lowest lander point above the surface at the start, m
+  Vec3 aim = Vec3::Zero();       // aim point on the trim plane (x, y used), m
+  double slope_deg = 0;          // gravity tilted about the horizontal axis normal to the motion; + = upslope
+  double g = 2.5e-4;             // gravity magnitude, m/s^2
+  double after_liftoff = 1.0;    // run end: this long after lift-off, s
+  double max_after_contact = 60; // ... or this long after first contact, s
+  double max_time = 600;         // safety net: no contact at all within this time, s
+  double far_ring = 0.05;        // width of the outer ring for the far-field quiet check, m
+  double sphere_radius = 0.155;  // volume-equivalent sphere radius for the travel distance, m
+  long repeat = 0;               // perturbed bed number (0: the bed as prepared)
+  unsigned long perturb_seed = 1;  // seed of the perturbation of repeat > 0
+  double sample_every = 0.01;    // s between time-series rows
+};
+
+// Read a `landing:` block (every error names the file and the key).
+LandingSpec parse_landing(const YAML::Node& node, const std::string& source);
+
+// Gravity vector of the spec (magnitude g, tilted for slopes).
+Vec3 landing_gravity(const LandingSpec& spec);
+
+// Rotate the whole bed about the vertical axis through the container centre
+// (positions, velocities, spins and contact springs), for perturbed repeats.
+void rotate_bed(const Model& m, State& s, double angle);
+
+// Perturbation of repeat r: bed rotation angle (rad) and aim offset (m,
+// within one mean grain diameter), drawn from the seed.
+struct Perturbation {
+  double angle = 0;
+  Vec3 aim_offset = Vec3::Zero();
+};
+Perturbation perturbation(const LandingSpec& spec, double mean_radius);
+
+// Place the lander body (index b) for the spec: attitude, the lowest point
+// `clearance` above the trim plane on the line of approach through the aim
+// point, velocity `speed` at `angle_deg` from the vertical, no spin.
+void place_lander(const Model& m, State& s, int b, const LandingSpec& spec);
+
+// World positions of the eight corners of the lander's largest box shape.
+std::vector<Vec3> lander_corners(const Model& m, const State& s, int b);
+
+struct LandingOutcome {
+  bool contact = false;          // the lander touched the bed
+  bool lifted_off = false;       // all eight corners went back above the trim plane
+  std::string ended_by;          // after_liftoff | max_after_contact | max_time
+  double t_contact = 0, t_liftoff = 0, t_end = 0;  // s
+  double v_in = 0, v_out = 0;    // centre-of-mass speed at first contact and at lift-off, m/s
+  double speed_ratio = 0;        // v_out / v_in
+  double e_lin_in = 0, e_rot_in = 0, e_lin_out = 0, e_rot_out = 0;  // J
+  double rot_out_over_lin_in = 0, rot_out_over_lin_out = 0, energy_ratio = 0;
+  double angle_out_deg = 0;      // outgoing velocity from the trim-plane normal, deg
+  double spin_out = 0;           // |omega| at lift-off, rad/s
+  double collision_duration = 0; // first contact to lift-off, s
+  double max_penetration = 0;    // deepest corner below the trim plane, m
+  double h_liftoff = 0;          // centre-of-mass height above the trim plane at lift-off, m
+  double travel_distance = 0;    // ballistic, to the next impact, m
+  double travel_time = 0;        // s
+  double second_impact_speed = 0;      // m/s
+  double second_impact_angle_deg = 0;  // from the normal, deg
+  double ejected_volume = 0;     // volume of grains whose centre ever rose > one mean radius above the plane, m^3
+  long ejected_grains = 0;
+  double far_field_rms = 0;      // RMS grain speed in the outer ring at the end, m/s
+  double max_overlap_ratio = 0;
+  long steps = 0;
+  double wall_seconds = 0;
+  std::string status = "ok";     // ok | blow_up
+  std::string message;
+};
+
+struct LandingOptions {
+  std::string out_dir;           // series.csv, summary.json, surface.csv (empty: nothing written)
+  double progress_every = 2.0;   // wall seconds between progress lines (<= 0: none)
+};
+
+// Run the landing from the placed state to the run end, observing the outcome.
+LandingOutcome run_landing(const Model& m, State& s, int b, const LandingSpec& spec, const LandingOptions& opt);
+
+// Height map of the bed surface (top of the highest grain per cell) over the
+// container, written as CSV rows "x,y,height above the trim plane".
+void write_surface(const std::string& path, const Model& m, const State& s, const LandingSpec& spec, double cell);
+
+}  // namespace rt

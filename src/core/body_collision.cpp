@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -83,6 +84,7 @@ struct ShapeEntry {
   std::unique_ptr<btCollisionObject> object;
   double breaking = 0;                                // Bullet's contact-breaking threshold of the shape, m
   double reach = 0;                                   // bounding radius about the body's centre of mass, m
+  bool smooth = false;                                // strictly convex (sphere, ellipsoid): one contact point
 };
 
 // A point reported by Bullet, converted to the conventions of the law.
@@ -209,6 +211,7 @@ ShapeEntry make_entry(const BodyModel& b, const Shape& sh) {
       break;
     }
   }
+  e.smooth = sh.type == ShapeType::Sphere || sh.type == ShapeType::Ellipsoid;
   e.object = std::make_unique<btCollisionObject>();
   e.object->setCollisionShape(e.shape.get());
   e.breaking = e.shape->getContactBreakingThreshold(gContactBreakingThreshold);
@@ -313,8 +316,8 @@ bool lex_less(const Vec3& u, const Vec3& v) {
 // deeper than the outline are dropped: on a flat patch they only bias the
 // centre of pressure (a box on two floor triangles also reports points along
 // their shared edge). A curved contact keeps its deepest point.
-void reduce_points(std::vector<RawPoint>& pts, double tol, std::vector<RawPoint>& tmp, std::vector<int>& idx,
-                   std::vector<int>& hull) {
+void reduce_points(std::vector<RawPoint>& pts, double tol, int max_points, std::vector<RawPoint>& tmp,
+                   std::vector<int>& idx, std::vector<int>& hull) {
   std::sort(pts.begin(), pts.end(), [](const RawPoint& p, const RawPoint& q) {
     if (p.depth != q.depth) return p.depth > q.depth;
     return lex_less(p.local_a, q.local_a);
@@ -326,6 +329,7 @@ void reduce_points(std::vector<RawPoint>& pts, double tol, std::vector<RawPoint>
     if (!dup) tmp.push_back(p);
   }
   pts.swap(tmp);
+  if (static_cast<int>(pts.size()) > max_points && max_points == 1) pts.resize(1);  // the deepest
   const int n = static_cast<int>(pts.size());
   if (n < 3) return;
   Vec3 nm = Vec3::Zero();
@@ -369,6 +373,31 @@ void reduce_points(std::vector<RawPoint>& pts, double tol, std::vector<RawPoint>
     if (corner || pts[i].depth > hull_depth * (1 + 1e-9)) tmp.push_back(pts[i]);
   }
   pts.swap(tmp);
+  // More corners than the contact may have (two polygons clipped against each
+  // other): keep a spread-out set, deepest first (pts is still depth-sorted):
+  // each next point is the one farthest from those already kept.
+  if (static_cast<int>(pts.size()) > max_points) {
+    tmp.clear();
+    tmp.push_back(pts[0]);
+    std::vector<uint8_t> taken(pts.size(), 0);
+    taken[0] = 1;
+    while (static_cast<int>(tmp.size()) < max_points) {
+      int best = -1;
+      double best_d = -1;
+      for (size_t i = 0; i < pts.size(); ++i) {
+        if (taken[i]) continue;
+        double d = 1e300;
+        for (const RawPoint& k : tmp) d = std::min(d, (pts[i].on_b - k.on_b).squaredNorm());
+        if (d > best_d) {
+          best_d = d;
+          best = static_cast<int>(i);
+        }
+      }
+      taken[best] = 1;
+      tmp.push_back(pts[best]);
+    }
+    pts.swap(tmp);
+  }
 }
 
 // Ordering key of a shape pair.
@@ -383,6 +412,16 @@ struct PairKey {
   bool operator==(const PairKey& o) const { return a == o.a && b == o.b && sa == o.sa && sb == o.sb; }
 };
 PairKey key_of(const BodyPointContact& c) { return {c.a, c.b, c.shape_a, c.shape_b}; }
+
+// Largest number of points of a face contact (Bullet's manifold size).
+constexpr int kFacePoints = 4;
+
+// Points a shape pair may have: one if either shape is strictly convex.
+int max_points(const Model& m, const BodyPointContact& c) {
+  auto smooth = [](ShapeType t) { return t == ShapeType::Sphere || t == ShapeType::Ellipsoid; };
+  const bool one = smooth(m.bodies[c.a].shapes[c.shape_a].type) || smooth(m.bodies[c.b].shapes[c.shape_b].type);
+  return one ? 1 : kFacePoints;
+}
 
 }  // namespace
 
@@ -493,7 +532,8 @@ void body_body_forces(const Model& m, State& s) {
           g.raw.clear();
           const double tol = narrow_phase(g, ta, tb, ea, eb, sa, sb);
           if (g.raw.empty()) continue;
-          reduce_points(g.raw, tol, g.raw_tmp, g.order, g.hull);
+          const int n_max = (ea.smooth || eb.smooth) ? 1 : kFacePoints;
+          reduce_points(g.raw, tol, n_max, g.raw_tmp, g.order, g.hull);
           const int n = static_cast<int>(g.raw.size());
           // Deterministic order: by the point's position on body a.
           std::sort(g.raw.begin(), g.raw.end(),
@@ -527,27 +567,22 @@ void body_body_forces(const Model& m, State& s) {
               g.match_old[c.j] = c.i;
             }
 
-          // The shape pair is one contact: its points share the pair's springs
-          // as n_eff = sum(x_i) / max(x_i) equal springs (n_eff = n when all
-          // points are equally deep, so each carries k/n), and its dashpots in
-          // proportion to depth. The total normal force is k_n max(x_i) for
-          // any number of points, and a point entering or leaving at zero
-          // depth changes no force.
-          double sum_x = 0, max_x = 0;
-          for (const RawPoint& p : g.raw) {
-            sum_x += p.depth;
-            max_x = std::max(max_x, p.depth);
-          }
-          const double share = max_x / sum_x;  // 1 / n_eff
+          // The shape pair is one contact of at most n_max points. Springs:
+          // every point carries a fixed share k/n_max (a face contact, n_max
+          // points, has the pair's k; an edge or a corner is softer), so the
+          // elastic force is the gradient of sum 1/2 (k/n_max) x_i^2 and a
+          // point enters and leaves at zero depth: no energy is created when
+          // points come and go. Dashpots: C/sqrt(n n_max) per point, the
+          // damping of n springs of k/n_max in parallel, so every
+          // configuration has the pair's restitution.
           PairLaw pl;
-          pl.kn = law.kn * share;
-          pl.kt = law.kt * share;
+          pl.kn = law.kn / n_max;
+          pl.kt = law.kt / n_max;
+          pl.cn_coef = law.cn / (std::sqrt(static_cast<double>(n) * n_max) * sm);
+          pl.ct_coef = law.ct / (std::sqrt(static_cast<double>(n) * n_max) * sm);
           pl.mu_s = law.mu_s;
           for (int i = 0; i < n; ++i) {
             const RawPoint& p = g.raw[i];
-            const double w = p.depth / sum_x;
-            pl.cn_coef = law.cn * w / sm;
-            pl.ct_coef = law.ct * w / sm;
             BodyPointContact c;
             c.a = a;
             c.b = b;
@@ -594,16 +629,11 @@ double body_body_elastic_energy(const Model& m, const State& s) {
   for (size_t i = 0; i < pts.size();) {
     size_t j = i;
     while (j < pts.size() && key_of(pts[j]) == key_of(pts[i])) ++j;
-    double sum_x = 0, max_x = 0;
-    for (size_t k = i; k < j; ++k) {
-      sum_x += pts[k].overlap;
-      max_x = std::max(max_x, pts[k].overlap);
-    }
-    const double share = sum_x > 0 ? max_x / sum_x : 0;
+    const double n_max = max_points(m, pts[i]);
     const BodyPairLaw law = body_pair_law(m, pts[i].a, pts[i].b);
     for (size_t k = i; k < j; ++k)
-      e += 0.5 * law.kn * share * pts[k].overlap * pts[k].overlap +
-           0.5 * law.kt * share * pts[k].spring_t.squaredNorm();
+      e += 0.5 * law.kn / n_max * pts[k].overlap * pts[k].overlap +
+           0.5 * law.kt / n_max * pts[k].spring_t.squaredNorm();
     i = j;
   }
   return e;

@@ -32,6 +32,17 @@ double elastic_energy(const Model& m, const State& s) {
     e += pair_elastic_energy<M>(m.law(m.grain_material[i], w.law_material), x, m.grain_radius[i], wl.spring_t[k],
                                 wl.spring_r[k], wl.spring_w[k]);
   }
+  const BodyGrainList& bl = s.body_grains;
+  for (int k = 0; k < bl.size(); ++k) {
+    const int i = bl.grain[k];
+    const BodyModel& bm = m.bodies[bl.body[k]];
+    const BodyState& bs = s.bodies[bl.body[k]];
+    const double x =
+        shape_gap(bm, bm.shapes[bl.shape[k]], bs.q.conjugate() * (s.pos[i] - bs.pos), m.grain_radius[i]).overlap;
+    if (x <= 0) continue;
+    e += pair_elastic_energy<M>(m.law(m.grain_material[i], bm.material), x, m.grain_radius[i], bl.spring_t[k],
+                                bl.spring_r[k], bl.spring_w[k]);
+  }
   return e;
 }
 
@@ -45,6 +56,13 @@ Energy energy(const Model& m, const State& s) {
     e.translational += 0.5 * mass * s.vel[i].squaredNorm();
     e.rotational += 0.5 * (1.0 / m.grain_inv_inertia[i]) * s.omega[i].squaredNorm();
     e.potential -= mass * m.gravity.dot(s.pos[i]);
+  }
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    const BodyModel& bm = m.bodies[b];
+    if (bm.fixed) continue;
+    e.translational += body_lin_energy(bm, s.bodies[b]);
+    e.rotational += body_rot_energy(bm, s.bodies[b]);
+    e.potential -= bm.mass * m.gravity.dot(s.bodies[b].pos);
   }
   if (s.lists_valid)
     e.elastic = m.contact_model == ContactModel::Linear ? elastic_energy<ContactModel::Linear>(m, s)

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "regolith_twin/core/body_collision.hpp"
 #include "regolith_twin/core/contact_law.hpp"
 #include "regolith_twin/core/walls.hpp"
 
@@ -163,6 +164,63 @@ void wall_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
   }
 }
 
+// Grain–body contacts of list entries [kb, ke): the grain's force goes to
+// State::force, the reaction to this partition's body accumulators. The body
+// side of the contact moves with the body's velocity at the contact point;
+// lever arm l_j = 0 and R = r_i, as for a wall (MODEL.md §5).
+template <ContactModel M, bool Resist>
+void body_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
+  BodyGrainList& bl = s.body_grains;
+  const double dt = m.dt;
+  for (int k = kb; k < ke; ++k) {
+    const int i = bl.grain[k], b = bl.body[k];
+    const BodyModel& bm = m.bodies[b];
+    const BodyState& bs = s.bodies[b];
+    const double ri = m.grain_radius[i];
+    const ShapeGap gap = shape_gap(bm, bm.shapes[bl.shape[k]], bs.q.conjugate() * (s.pos[i] - bs.pos), ri);
+    if (gap.overlap <= 0) {
+      if (bl.touching[k]) {
+        bl.touching[k] = 0;
+        bl.spring_t[k].setZero();
+        bl.spring_r[k].setZero();
+        bl.spring_w[k] = 0;
+      }
+      continue;
+    }
+    bl.touching[k] = 1;
+    PairInput in;
+    in.n = bs.q * gap.n;
+    in.x = gap.overlap;
+    in.li = ri - 0.5 * in.x;
+    in.lj = 0;
+    in.reff = ri;
+    in.sqrt_mstar = bl.sqrt_mstar[k];
+    const Vec3 arm = s.pos[i] + in.li * in.n - bs.pos;  // contact point from the body's centre of mass
+    in.vrel = bs.vel + bs.omega.cross(arm) - s.vel[i];
+    in.wi = s.omega[i];
+    in.wj = bs.omega;
+    in.vrel_mid = bs.vel_mid + bs.omega_mid.cross(arm) - s.vel_mid[i];
+    in.wi_mid = s.omega_mid[i];
+    in.wj_mid = bs.omega_mid;
+    const PairLaw& law = m.law(m.grain_material[i], bm.material);
+    const PairOutput out =
+        pair_contact<M, Resist>(law, in, PairSprings{bl.spring_t[k], bl.spring_r[k], bl.spring_w[k]}, dt);
+    s.force[i] += out.force_i;
+    s.torque[i] += out.torque_i;
+    sc.body_force[b] -= out.force_i;
+    sc.body_torque[b] += out.torque_j - arm.cross(out.force_i);
+    ++sc.contacts;
+    if (s.log_contacts)
+      sc.log.push_back({i, -1000000 - b, in.x, out.fn, out.ft.norm(), out.mr.norm(), std::fabs(out.mt), law.mu_s,
+                        law.mu_r, law.mu_t, law.beta, in.reff});
+    const double ratio = in.x / ri;
+    if (ratio > sc.max_overlap_ratio) {
+      sc.max_overlap_ratio = ratio;
+      sc.max_overlap_grain = i;
+    }
+  }
+}
+
 template <ContactModel M, bool Resist>
 void force_pass(const Model& m, State& s) {
   const int P = m.partitions;
@@ -172,8 +230,11 @@ void force_pass(const Model& m, State& s) {
     sc.contacts = 0;
     sc.max_overlap_ratio = 0;
     sc.max_overlap_grain = -1;
+    std::fill(sc.body_force.begin(), sc.body_force.end(), Vec3::Zero());
+    std::fill(sc.body_torque.begin(), sc.body_torque.end(), Vec3::Zero());
   }
-  long wall_contacts = 0;
+  const bool bodies = !m.bodies.empty();
+  long wall_contacts = 0, body_contacts = 0;
 #pragma omp parallel if (n >= m.parallel_min_grains)
   {
     const int tid = thread_id(), nt = thread_count();
@@ -208,7 +269,29 @@ void force_pass(const Model& m, State& s) {
 #pragma omp atomic
       wall_contacts += sc.contacts - before;
     }
+    if (bodies) {
+      // Grain–body contacts, after every wall contact has been added.
+#pragma omp barrier
+      for (int p = tid; p < P; p += nt) {
+        ThreadScratch& sc = s.scratch[p];
+        const long before = sc.contacts;
+        body_entries<M, Resist>(m, s, s.thread_body_begin[p], s.thread_body_begin[p + 1], sc);
+#pragma omp atomic
+        body_contacts += sc.contacts - before;
+      }
+    }
   }
+  // Body wrenches: grain reactions merged in partition order, then body–body contacts.
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    BodyState& bs = s.bodies[b];
+    bs.force.setZero();
+    bs.torque.setZero();
+    for (const auto& sc : s.scratch) {
+      bs.force += sc.body_force[b];
+      bs.torque += sc.body_torque[b];
+    }
+  }
+  if (m.bodies.size() > 1) body_body_forces(m, s);
   StepStats& st = s.stats;
   st.contacts = 0;
   st.max_overlap_ratio = 0;
@@ -221,7 +304,8 @@ void force_pass(const Model& m, State& s) {
     }
   }
   st.wall_contacts = wall_contacts;
-  st.contacts -= wall_contacts;
+  st.body_contacts = body_contacts;
+  st.contacts -= wall_contacts + body_contacts;
 }
 
 }  // namespace

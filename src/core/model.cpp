@@ -142,6 +142,10 @@ void finalize_model(Model& m) {
   }
   for (const auto& w : m.walls)
     if (w.law_material < 0 || w.law_material >= nm) throw InputError("model: wall '" + w.name + "' has an unknown material");
+  for (auto& b : m.bodies) {
+    if (b.material < 0 || b.material >= nm) throw InputError("model: body '" + b.name + "' has an unknown material");
+    finalize_body(b);
+  }
 
   m.pair_law.assign(static_cast<size_t>(nm) * nm, PairLaw{});
   m.any_resistance = false;
@@ -202,6 +206,14 @@ std::vector<PairResolution> pair_resolution(const Model& m, double v_ref) {
                      tc / m.dt});
     }
   }
+  for (const auto& b : m.bodies)
+    for (int a = 0; a < nm; ++a) {
+      if (mmin[a] == 0) continue;
+      const PairLaw& L = m.law(a, b.material);
+      const double ms = b.fixed ? mmin[a] : mmin[a] * b.mass / (mmin[a] + b.mass);
+      const double tc = time_of(L, ms, rmin[a], L.eps_n);
+      out.push_back({"grain-body (" + m.materials[a].name + "/" + b.name + ")", tc, tc / m.dt});
+    }
   return out;
 }
 

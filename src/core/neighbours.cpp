@@ -55,6 +55,7 @@ Grid bin_grains(const Model& m, State& s) {
   }
   if (n == 0) lo = hi = Vec3::Zero();
   double cell = 2 * m.max_radius + m.skin;
+  if (!(cell > 0)) cell = 1.0;  // no grains: any cell size
   const long max_cells = std::max<long>(4L * n, 64);
   Grid g{};
   for (;;) {
@@ -165,7 +166,103 @@ void build_walls(const Model& m, State& s) {
   std::swap(s.wall_pairs, s.wall_pairs_next);
 }
 
+// Grain–body candidates: every grain whose gap to a body shape is below the
+// skin, sorted by (grain, body, shape); history carried by that key.
+void build_body_grains(const Model& m, State& s) {
+  BodyGrainList& nl = s.body_grains_next;
+  nl.grain.clear();
+  nl.body.clear();
+  nl.shape.clear();
+  nl.sqrt_mstar.clear();
+  const int nb = static_cast<int>(m.bodies.size());
+  for (int i = 0; i < m.n_grains; ++i) {
+    const double ri = m.grain_radius[i];
+    for (int b = 0; b < nb; ++b) {
+      const BodyModel& bm = m.bodies[b];
+      const BodyState& bs = s.bodies[b];
+      const double inv = m.grain_inv_mass[i] + bm.inv_mass();
+      if (inv == 0) continue;  // glued grain against an immovable body
+      const Vec3 d = s.pos[i] - bs.pos;
+      const double reach = bm.bound_radius + ri + m.skin;
+      if (d.squaredNorm() > reach * reach) continue;
+      const Vec3 p = bs.q.conjugate() * d;
+      for (int k = 0; k < static_cast<int>(bm.shapes.size()); ++k) {
+        if (shape_gap(bm, bm.shapes[k], p, ri).overlap > -m.skin) {
+          nl.grain.push_back(i);
+          nl.body.push_back(b);
+          nl.shape.push_back(k);
+          nl.sqrt_mstar.push_back(std::sqrt(1.0 / inv));
+        }
+      }
+    }
+  }
+  size_history(nl, nl.size());
+  const BodyGrainList& ol = s.body_grains;
+  auto less = [](const BodyGrainList& a, int ka, const BodyGrainList& b, int kb) {
+    if (a.grain[ka] != b.grain[kb]) return a.grain[ka] < b.grain[kb];
+    if (a.body[ka] != b.body[kb]) return a.body[ka] < b.body[kb];
+    return a.shape[ka] < b.shape[kb];
+  };
+  int o = 0;
+  const int on = ol.size();
+  for (int k = 0; k < nl.size(); ++k) {
+    while (o < on && less(ol, o, nl, k)) ++o;
+    if (o < on && !less(nl, k, ol, o)) {
+      nl.spring_t[k] = ol.spring_t[o];
+      nl.spring_r[k] = ol.spring_r[o];
+      nl.spring_w[k] = ol.spring_w[o];
+      nl.touching[k] = ol.touching[o];
+    } else {
+      nl.spring_t[k].setZero();
+      nl.spring_r[k].setZero();
+      nl.spring_w[k] = 0;
+      nl.touching[k] = 0;
+    }
+  }
+  std::swap(s.body_grains, s.body_grains_next);
+  for (int b = 0; b < nb; ++b) {
+    s.bodies[b].pos_at_build = s.bodies[b].pos;
+    s.bodies[b].q_at_build = s.bodies[b].q;
+  }
+  s.body_list_grain_disp = std::sqrt(s.stats.max_disp2);
+  partition_body_list(m, s);
+  ++s.body_rebuilds;
+}
+
+// Largest displacement of any body point since the grain–body list was built.
+double max_body_displacement(const Model& m, const State& s) {
+  double worst = 0;
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    const BodyState& bs = s.bodies[b];
+    const double angle = bs.q_at_build.angularDistance(bs.q);
+    worst = std::max(worst, (bs.pos - bs.pos_at_build).norm() + angle * m.bodies[b].bound_radius);
+  }
+  return worst;
+}
+
 }  // namespace
+
+bool body_list_needs_rebuild(const Model& m, const State& s) {
+  if (m.bodies.empty()) return false;
+  // A gap can close by at most the grain's plus the body's displacement since
+  // the build; grains are measured from pos_at_build (triangle inequality).
+  return std::sqrt(s.stats.max_disp2) + s.body_list_grain_disp + max_body_displacement(m, s) > m.skin;
+}
+
+void partition_body_list(const Model& m, State& s) {
+  // Entries split at grain boundaries into the fixed partitions.
+  const int P = m.partitions;
+  s.thread_body_begin.resize(P + 1);
+  const BodyGrainList& bl = s.body_grains;
+  for (int p = 0; p <= P; ++p) {
+    int k = int(long(bl.size()) * p / P);
+    while (k > 0 && k < bl.size() && bl.grain[k] == bl.grain[k - 1]) ++k;
+    s.thread_body_begin[p] = k;
+  }
+  for (int p = 1; p <= P; ++p) s.thread_body_begin[p] = std::max(s.thread_body_begin[p], s.thread_body_begin[p - 1]);
+}
+
+void build_body_list(const Model& m, State& s) { build_body_grains(m, s); }
 
 // Split rows into partitions of about equal entry counts; record the grain
 // range each partition writes so merging touches only that range.
@@ -219,6 +316,7 @@ void build_neighbour_lists(const Model& m, State& s) {
   partition_work(m, s);
   s.pos_at_build = s.pos;
   s.stats.max_disp2 = 0;
+  build_body_grains(m, s);
   s.lists_valid = true;
   s.rebuild_requested = false;
   ++s.rebuilds;

@@ -15,7 +15,12 @@ State make_state(const Model& m) {
   s.torque.assign(n, Vec3::Zero());
   s.pos_at_build.assign(n, Vec3::Zero());
   s.wall_on.assign(m.walls.size(), 1);
+  s.bodies.resize(m.bodies.size());
   s.scratch.resize(m.partitions);
+  for (auto& sc : s.scratch) {
+    sc.body_force.assign(m.bodies.size(), Vec3::Zero());
+    sc.body_torque.assign(m.bodies.size(), Vec3::Zero());
+  }
   for (int p = 1; p < m.partitions; ++p) {
     s.scratch[p].force.assign(n, Vec3::Zero());
     s.scratch[p].torque.assign(n, Vec3::Zero());
@@ -38,6 +43,17 @@ State make_state(const Model& m) {
     l->spring_r.reserve(wall_cap);
     l->spring_w.reserve(wall_cap);
     l->touching.reserve(wall_cap);
+  }
+  const size_t body_cap = m.bodies.empty() ? 0 : size_t(n) / 4 + 256;
+  for (BodyGrainList* l : {&s.body_grains, &s.body_grains_next}) {
+    l->grain.reserve(body_cap);
+    l->body.reserve(body_cap);
+    l->shape.reserve(body_cap);
+    l->sqrt_mstar.reserve(body_cap);
+    l->spring_t.reserve(body_cap);
+    l->spring_r.reserve(body_cap);
+    l->spring_w.reserve(body_cap);
+    l->touching.reserve(body_cap);
   }
   s.cell_start.reserve(4 * size_t(n) + 66);
   s.cell_items.reserve(n);

@@ -15,9 +15,23 @@ void prime(const Model& m, State& s) {
   // are put back after the pass.
   s.vel_mid = s.vel;
   s.omega_mid = s.omega;
+  for (BodyState& b : s.bodies) {
+    b.vel_mid = b.vel;
+    b.omega_mid = b.omega;
+  }
   const PairList springs = s.pairs;
   const WallList wall_springs = s.wall_pairs;
+  const BodyGrainList body_springs = s.body_grains;
+  const std::vector<BodyPointContact> body_points = s.body_points;
   compute_forces(m, s);
+  s.body_grains.spring_t = body_springs.spring_t;
+  s.body_grains.spring_r = body_springs.spring_r;
+  s.body_grains.spring_w = body_springs.spring_w;
+  for (size_t k = 0; k < s.body_points.size(); ++k)  // points matched to earlier ones keep their spring
+    for (const BodyPointContact& old : body_points)
+      if (old.a == s.body_points[k].a && old.b == s.body_points[k].b && old.shape_a == s.body_points[k].shape_a &&
+          old.shape_b == s.body_points[k].shape_b && old.local_a == s.body_points[k].local_a)
+        s.body_points[k].spring_t = old.spring_t;
   s.pairs.spring_t = springs.spring_t;
   s.pairs.spring_r = springs.spring_r;
   s.pairs.spring_w = springs.spring_w;
@@ -29,10 +43,15 @@ void prime(const Model& m, State& s) {
 void step(const Model& m, State& s) {
   if (!s.forces_valid) prime(m, s);
   kick_drift(m, s, 0.5 * m.dt, m.dt);                              // integrate: half kick, drift
+  kick_drift_bodies(m, s, 0.5 * m.dt, m.dt);
   check_guards(m, s);
-  if (lists_need_rebuild(m, s)) build_neighbour_lists(m, s);       // neighbours
+  if (lists_need_rebuild(m, s))                                    // neighbours
+    build_neighbour_lists(m, s);
+  else if (body_list_needs_rebuild(m, s))
+    build_body_list(m, s);
   compute_forces(m, s);                                            // contacts -> forces
   finish_kick(m, s, 0.5 * m.dt);                                   // integrate: half kick
+  finish_kick_bodies(m, s, 0.5 * m.dt);
   s.time += m.dt;
   ++s.step;
   check_guards(m, s);                                              // guards

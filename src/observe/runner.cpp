@@ -75,7 +75,7 @@ void write_final(const std::string& path, const Model& m, const State& s) {
 
 }  // namespace
 
-RunReport run_scenario(const Scenario& sc, State& s, const RunOptions& opt) {
+RunReport run_scenario(Scenario& sc, State& s, const RunOptions& opt) {
   const Model& m = sc.model;
   RunReport rep;
   const bool write = !opt.out_dir.empty();
@@ -128,6 +128,16 @@ RunReport run_scenario(const Scenario& sc, State& s, const RunOptions& opt) {
   try {
     for (size_t k = 0; k < sc.stages.size(); ++k) {
       const Stage& st = sc.stages[k];
+      int removed = 0;
+      if (st.trim) {  // remove every grain above the trim height
+        std::vector<uint8_t> drop(m.n_grains, 0);
+        for (int i = 0; i < m.n_grains; ++i) drop[i] = s.pos[i].z() > st.trim_above;
+        removed = remove_grains(sc, s, drop);
+        held.assign(m.n_grains, 0);
+      }
+      const Vec3 g_from = m.gravity;
+      if (st.set_gravity && st.gravity_ramp <= 0) sc.model.gravity = st.gravity;
+      const double t_ramp0 = s.time;
       std::fill(held.begin(), held.end(), 0);
       std::vector<Vec3> held_pos;
       std::vector<int> held_ids;
@@ -147,8 +157,19 @@ RunReport run_scenario(const Scenario& sc, State& s, const RunOptions& opt) {
       }
       const double t_stage1 = s.time + st.duration;
       double next_check = s.time + st.check_every;
-      StageReport sr{st.name, 0, "duration"};
+      StageReport sr{st.name, 0, "duration", removed};
       while (s.time < t_stage1 - 0.5 * m.dt) {
+        if (st.set_gravity && st.gravity_ramp > 0) {
+          // Geometric in magnitude, linear in direction, over gravity_ramp seconds.
+          const double f = std::min(1.0, (s.time - t_ramp0) / st.gravity_ramp);
+          const double a = g_from.norm(), b = st.gravity.norm();
+          if (f >= 1.0 || a == 0 || b == 0) {
+            sc.model.gravity = f >= 1.0 ? st.gravity : Vec3(g_from + f * (st.gravity - g_from));
+          } else {
+            const Vec3 dir = ((1 - f) * g_from / a + f * st.gravity / b).normalized();
+            sc.model.gravity = dir * (a * std::pow(b / a, f));
+          }
+        }
         if (s.time >= next_sample - 0.5 * m.dt) {
           if (write) sample();
           next_sample += sc.output_every;
@@ -229,6 +250,7 @@ RunReport run_scenario(const Scenario& sc, State& s, const RunOptions& opt) {
     for (const auto& r : rep.stages) {
       JsonObject o;
       o.num("t_end", r.t_end).str("ended_by", r.reason);
+      if (r.grains_removed) o.num("grains_removed", r.grains_removed);
       stages.obj(r.name, o);
     }
     j.obj("stages", stages);

@@ -14,7 +14,7 @@ namespace rt {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'G', 'T', 'W', 'C', 'K', 'P', 'T'};
-constexpr uint32_t kVersion = 2;
+constexpr uint32_t kVersion = 3;  // 3: rigid bodies; 2 (grains only) is still read
 
 uint64_t fnv1a(const char* p, size_t n, uint64_t h = 1469598103934665603ULL) {
   for (size_t i = 0; i < n; ++i) {
@@ -114,6 +114,17 @@ void save_checkpoint(const std::string& path, const Model& m, const State& s) {
   w.vec(s.wall_pairs.grain);
   w.vec(s.wall_pairs.wall);
   put_springs(w, s.wall_pairs);
+  // Rigid bodies: states, grain–body list with history, body–body points.
+  w.pod<uint64_t>(m.bodies.size());
+  w.vec(s.bodies);
+  w.pod(s.body_list_grain_disp);
+  w.pod<int64_t>(s.body_rebuilds);
+  w.vec(s.body_grains.grain);
+  w.vec(s.body_grains.body);
+  w.vec(s.body_grains.shape);
+  w.vec(s.body_grains.sqrt_mstar);
+  put_springs(w, s.body_grains);
+  w.vec(s.body_points);
   const uint64_t sum = fnv1a(w.buf.data(), w.buf.size());
   w.pod(sum);
 
@@ -143,7 +154,7 @@ State load_checkpoint(const std::string& path, const Model& m) {
   char magic[8];
   r.raw(magic, 8);
   const uint32_t version = r.pod<uint32_t>();
-  if (version != kVersion)
+  if (version != kVersion && version != 2)
     r.fail("format version " + std::to_string(version) + ", this build reads version " + std::to_string(kVersion));
   const uint64_t n = r.pod<uint64_t>();
   if (n != uint64_t(m.n_grains))
@@ -164,6 +175,29 @@ State load_checkpoint(const std::string& path, const Model& m) {
   r.vec(s.wall_pairs.grain);
   r.vec(s.wall_pairs.wall);
   get_springs(r, s.wall_pairs, s.wall_pairs.grain.size());
+  if (version >= 3) {
+    const uint64_t nb = r.pod<uint64_t>();
+    if (nb != m.bodies.size())
+      r.fail("it holds " + std::to_string(nb) + " bodies, the scenario has " + std::to_string(m.bodies.size()));
+    r.vec(s.bodies, nb);
+    s.body_list_grain_disp = r.pod<double>();
+    s.body_rebuilds = r.pod<int64_t>();
+    BodyGrainList& bl = s.body_grains;
+    r.vec(bl.grain);
+    r.vec(bl.body, bl.grain.size());
+    r.vec(bl.shape, bl.grain.size());
+    r.vec(bl.sqrt_mstar, bl.grain.size());
+    get_springs(r, bl, bl.grain.size());
+    r.vec(s.body_points);
+    for (size_t k = 0; k < bl.grain.size(); ++k)
+      if (bl.grain[k] < 0 || bl.grain[k] >= m.n_grains || bl.body[k] < 0 || bl.body[k] >= int(nb) ||
+          bl.shape[k] < 0 || bl.shape[k] >= int(m.bodies[bl.body[k]].shapes.size()))
+        r.fail("grain–body list refers to a grain, body or shape that does not exist");
+    for (const auto& pt : s.body_points)
+      if (pt.a < 0 || pt.b < 0 || pt.a >= int(nb) || pt.b >= int(nb)) r.fail("body contact refers to a missing body");
+  } else if (!m.bodies.empty()) {
+    r.fail("format version 2 holds no bodies, the scenario has " + std::to_string(m.bodies.size()));
+  }
   if (r.pos() + 8 != data.size()) r.fail("unexpected trailing data");
   for (int p : s.pairs.partner)
     if (p < 0 || p >= m.n_grains) r.fail("pair list refers to a grain that does not exist");
@@ -173,6 +207,7 @@ State load_checkpoint(const std::string& path, const Model& m) {
       r.fail("wall list refers to a grain or wall that does not exist");
   if (live) {
     partition_work(m, s);
+    partition_body_list(m, s);
     s.lists_valid = s.forces_valid = true;
   }
   return s;

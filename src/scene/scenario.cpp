@@ -14,6 +14,8 @@
 #include "regolith_twin/core/walls.hpp"
 #include "regolith_twin/scene/data_file.hpp"
 #include "regolith_twin/scene/generate.hpp"
+#include "regolith_twin/scene/snapshot.hpp"
+#include "regolith_twin/scene/urdf_body.hpp"
 
 namespace rt {
 namespace {
@@ -361,9 +363,16 @@ void parse_grains(const Reader& rd, Scenario& sc, const YAML::Node& g, const std
     // A relative path is taken from the scenario file's folder.
     const auto slash = rd.source().rfind('/');
     if (!file.empty() && file[0] != '/' && slash != std::string::npos) file = rd.source().substr(0, slash + 1) + file;
-    for (const auto& rec : read_sphere_data(file)) {
-      pos.push_back(rec.pos);
-      radii.push_back(rec.radius);
+    if (is_snapshot(file)) {
+      for (const auto& rec : read_snapshot(file)) {
+        pos.push_back(rec.pos);
+        radii.push_back(rec.radius);
+      }
+    } else {
+      for (const auto& rec : read_sphere_data(file)) {
+        pos.push_back(rec.pos);
+        radii.push_back(rec.radius);
+      }
     }
   }
   for (size_t k = 0; k < pos.size(); ++k) add_grain(m, radii[k], mat, fixed);
@@ -375,6 +384,121 @@ void parse_grains(const Reader& rd, Scenario& sc, const YAML::Node& g, const std
     sc.initial.vel.push_back(vel);
     sc.initial.omega.push_back(omg);
   }
+}
+
+// Orientation from {rpy: [roll, pitch, yaw]} in radians, {rpy_deg: [...]} in
+// degrees (fixed axes x, then y, then z, as URDF), or {quaternion: [w, x, y, z]}.
+Quat parse_orientation(const Reader& rd, const YAML::Node& parent, const std::string& path, const std::string& key) {
+  const YAML::Node o = rd.map(parent, path, key, false);
+  if (!o) return Quat::Identity();
+  const std::string p = Reader::join(path, key);
+  rd.only(o, p, {"rpy", "rpy_deg", "quaternion"});
+  if (o.size() != 1) rd.fail(p, "give exactly one of rpy (rad), rpy_deg or quaternion [w, x, y, z]");
+  if (o["quaternion"]) {
+    const YAML::Node qn = o["quaternion"];
+    if (!qn.IsSequence() || qn.size() != 4) rd.fail(p + ".quaternion", "expected [w, x, y, z]");
+    Quat q(rd.number(qn[0], p + ".quaternion[0]", -kInf, kInf), rd.number(qn[1], p + ".quaternion[1]", -kInf, kInf),
+           rd.number(qn[2], p + ".quaternion[2]", -kInf, kInf), rd.number(qn[3], p + ".quaternion[3]", -kInf, kInf));
+    if (!(q.norm() > 0)) rd.fail(p + ".quaternion", "must be non-zero");
+    return q.normalized();
+  }
+  const bool deg = bool(o["rpy_deg"]);
+  const Vec3 a = rd.vec3(o, p, deg ? "rpy_deg" : "rpy", Vec3::Zero(), true) * (deg ? M_PI / 180 : 1.0);
+  return Quat(Eigen::AngleAxisd(a.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(a.y(), Vec3::UnitY()) *
+              Eigen::AngleAxisd(a.x(), Vec3::UnitX()));
+}
+
+// An inline collision shape: {type: box|sphere|cylinder|ellipsoid, size, position, orientation}.
+// Sizes are full extents for a box, [a, b, c] semi-axes for an ellipsoid,
+// radius for a sphere, [radius, length] for a cylinder along its z axis.
+Shape parse_shape(const Reader& rd, const YAML::Node& n, const std::string& path) {
+  rd.only(n, path, {"type", "size", "radius", "length", "position", "orientation"});
+  Shape sh;
+  const std::string type = rd.choice(n, path, "type", "", {"box", "sphere", "cylinder", "ellipsoid"});
+  if (type == "box" || type == "ellipsoid") {
+    const Vec3 v = rd.vec3(n, path, "size", Vec3::Zero(), true);
+    for (int k = 0; k < 3; ++k)
+      if (!(v[k] > 0)) rd.fail(Reader::join(path, "size"), "every extent must be > 0 m");
+    sh.type = type == "box" ? ShapeType::Box : ShapeType::Ellipsoid;
+    sh.size = type == "box" ? Vec3(v / 2) : v;
+  } else if (type == "sphere") {
+    sh.type = ShapeType::Sphere;
+    sh.size = Vec3::Constant(rd.number(n, path, "radius", 0, 0, kInf, true));
+    if (!n["radius"]) rd.fail(Reader::join(path, "radius"), "missing (m, > 0)");
+  } else {
+    sh.type = ShapeType::Cylinder;
+    const double r = rd.number(n, path, "radius", 0, 0, kInf, true), l = rd.number(n, path, "length", 0, 0, kInf, true);
+    if (!n["radius"] || !n["length"]) rd.fail(path, "a cylinder needs radius and length (m, > 0)");
+    sh.size = Vec3(r, r, l / 2);
+  }
+  sh.pos = rd.vec3(n, path, "position", Vec3::Zero());
+  sh.rot = parse_orientation(rd, n, path, "orientation");
+  sh.link = path;
+  return sh;
+}
+
+// A rigid body from a URDF file or from inline shapes. The pose is that of
+// the description's reference frame (URDF root link, or the inline frame).
+void parse_body(const Reader& rd, Scenario& sc, const YAML::Node& n, const std::string& path) {
+  rd.only(n, path,
+          {"name", "urdf", "link_box", "shapes", "mass", "inertia", "center_of_mass", "fixed", "material", "position",
+           "orientation", "velocity", "omega"});
+  Model& m = sc.model;
+  BodyModel b;
+  const bool from_urdf = bool(n["urdf"]);
+  if (from_urdf == bool(n["shapes"])) rd.fail(path, "give exactly one of 'urdf' (a file) or 'shapes' (a list)");
+  b.fixed = rd.boolean(n, path, "fixed", false);
+  if (from_urdf) {
+    std::string file = rd.text(n, path, "urdf", "");
+    const auto slash = rd.source().rfind('/');
+    if (!file.empty() && file[0] != '/' && slash != std::string::npos && !std::ifstream(file))
+      file = rd.source().substr(0, slash + 1) + file;
+    UrdfOverrides ov;
+    if (const YAML::Node lb = rd.map(n, path, "link_box", false))
+      for (const auto& kv : lb) {
+        const std::string link = kv.first.as<std::string>();
+        ov.box_size[link] = rd.vec3(lb, Reader::join(path, "link_box"), link, Vec3::Zero(), true);
+      }
+    try {
+      b = load_urdf_body(file, ov);
+    } catch (const InputError& e) {
+      rd.fail(Reader::join(path, "urdf"), e.what());
+    }
+    b.fixed = rd.boolean(n, path, "fixed", false);
+  } else {
+    const YAML::Node shapes = n["shapes"];
+    if (!shapes.IsSequence() || shapes.size() == 0) rd.fail(Reader::join(path, "shapes"), "expected a non-empty list");
+    for (size_t k = 0; k < shapes.size(); ++k)
+      b.shapes.push_back(parse_shape(rd, shapes[k], Reader::join(path, "shapes[" + std::to_string(k) + "]")));
+    if (!b.fixed) {
+      b.mass = rd.number(n, path, "mass", 0, 0, kInf, true);
+      if (!n["mass"]) rd.fail(Reader::join(path, "mass"), "missing (kg, > 0)");
+      b.inertia = rd.vec3(n, path, "inertia", Vec3::Zero(), true);  // principal moments about the shapes' axes
+      const Vec3 com = rd.vec3(n, path, "center_of_mass", Vec3::Zero());
+      for (Shape& sh : b.shapes) sh.pos -= com;
+      b.ref_pos = com;
+    }
+    b.ref_frame = "base";
+  }
+  b.name = rd.text(n, path, "name", b.name.empty() ? path : b.name);
+  b.material = material_index(rd, m, n, path);
+  try {
+    finalize_body(b);
+  } catch (const InputError& e) {
+    rd.fail(path, e.what());
+  }
+  // Initial pose and velocity of the reference frame.
+  const Vec3 ref_pos = rd.vec3(n, path, "position", Vec3::Zero());
+  const Quat ref_q = parse_orientation(rd, n, path, "orientation");
+  BodyState bs;
+  bs.q = (ref_q * b.ref_rot).normalized();
+  bs.pos = ref_pos + ref_q * b.ref_pos;
+  const Vec3 v = rd.vec3(n, path, "velocity", Vec3::Zero()), w = rd.vec3(n, path, "omega", Vec3::Zero());
+  for (const auto& other : m.bodies)
+    if (other.name == b.name) rd.fail(Reader::join(path, "name"), "duplicate body name '" + b.name + "'");
+  m.bodies.push_back(b);
+  set_body_velocity(m.bodies.back(), bs, v, w);
+  sc.initial.bodies.push_back(bs);
 }
 
 void apply_override(YAML::Node root, const std::string& assignment) {
@@ -429,6 +553,42 @@ bool material_preset(const std::string& name, Material& out) {
   return true;
 }
 
+int remove_grains(Scenario& sc, State& s, const std::vector<uint8_t>& drop) {
+  Model& m = sc.model;
+  const int n = m.n_grains;
+  std::vector<int> keep;
+  for (int i = 0; i < n; ++i)
+    if (!drop[i]) keep.push_back(i);
+  if (int(keep.size()) == n) return 0;
+  Model nm = m;
+  nm.n_grains = 0;
+  nm.grain_radius.clear();
+  nm.grain_material.clear();
+  nm.grain_fixed.clear();
+  for (int i : keep) add_grain(nm, m.grain_radius[i], m.grain_material[i], m.grain_fixed[i] != 0);
+  finalize_model(nm);
+  State ns = make_state(nm);
+  for (size_t k = 0; k < keep.size(); ++k) {
+    ns.pos[k] = s.pos[keep[k]];
+    ns.vel[k] = s.vel[keep[k]];
+    ns.omega[k] = s.omega[keep[k]];
+  }
+  ns.time = s.time;
+  ns.step = s.step;
+  ns.bodies = s.bodies;
+  ns.wall_on = s.wall_on;
+  for (GrainGroup& g : sc.groups) {
+    const int first = int(std::lower_bound(keep.begin(), keep.end(), g.first) - keep.begin());
+    const int last = int(std::lower_bound(keep.begin(), keep.end(), g.first + g.count) - keep.begin());
+    g.first = first;
+    g.count = last - first;
+  }
+  const int removed = n - int(keep.size());
+  m = std::move(nm);
+  s = std::move(ns);
+  return removed;
+}
+
 const GrainGroup* Scenario::group(const std::string& n) const {
   for (const auto& g : groups)
     if (g.name == n) return &g;
@@ -439,7 +599,8 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   const Reader rd(source);
   if (!root || !root.IsMap()) throw InputError(source + ": expected a YAML mapping at the top level");
   rd.only(root, "",
-          {"name", "seed", "gravity", "contact", "guards", "materials", "walls", "grains", "stages", "output"});
+          {"name", "seed", "gravity", "contact", "guards", "materials", "walls", "bodies", "grains", "stages",
+           "output"});
   Scenario sc;
   sc.file = source;
   sc.name = rd.text(root, "", "name", "scenario");
@@ -463,10 +624,20 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
       m.walls.push_back(parse_wall(rd, m, walls[i], "walls[" + std::to_string(i) + "]"));
   }
 
+  // Bodies.
+  if (const YAML::Node bodies = root["bodies"]) {
+    if (!bodies.IsSequence()) rd.fail("bodies", "expected a list of bodies");
+    for (size_t i = 0; i < bodies.size(); ++i) parse_body(rd, sc, bodies[i], "bodies[" + std::to_string(i) + "]");
+  }
+
   // Grains.
   const YAML::Node grains = root["grains"];
-  if (!grains || !grains.IsSequence() || grains.size() == 0) rd.fail("grains", "expected a non-empty list");
-  for (size_t i = 0; i < grains.size(); ++i)
+  if (!m.bodies.empty() && !grains) {
+    // a scene of bodies only
+  } else if (!grains || !grains.IsSequence() || grains.size() == 0) {
+    rd.fail("grains", "expected a non-empty list");
+  }
+  for (size_t i = 0; grains && i < grains.size(); ++i)
     parse_grains(rd, sc, grains[i], "grains[" + std::to_string(i) + "]", rng);
 
   // Contact law, stiffness and time step.
@@ -481,7 +652,14 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
     mean_mass += 4.0 / 3.0 * M_PI * r * r * r * m.materials[m.grain_material[i]].density;
     min_r = std::min(min_r, r);
   }
-  mean_mass /= m.n_grains;
+  if (m.n_grains == 0) {
+    if (!Reader::get(c, "kn") || !Reader::get(c, "dt") || c["kn"].Scalar() == "rule")
+      rd.fail("contact", "a scene without grains needs explicit contact.kn (N/m) and contact.dt (s)");
+    mean_mass = 1;
+    min_r = 1;
+  } else {
+    mean_mass /= m.n_grains;
+  }
   sc.v_ref = rd.number(c, "contact", "v_max", 1.0, 0, 1e5, true);
   const double x_max = rd.number(c, "contact", "x_max", 0.01, 0, 0.5, true) * min_r;
   if (Reader::get(c, "kn") && !(c["kn"].IsScalar() && c["kn"].Scalar() == "rule"))
@@ -519,7 +697,9 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   // Initial state.
   std::vector<Vec3> pos = std::move(sc.initial.pos), vel = std::move(sc.initial.vel),
                     omg = std::move(sc.initial.omega);
+  std::vector<BodyState> bodies = std::move(sc.initial.bodies);
   sc.initial = make_state(m);
+  sc.initial.bodies = bodies;
   sc.initial.pos = pos;
   sc.initial.vel = vel;
   sc.initial.omega = omg;
@@ -530,7 +710,8 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
     for (size_t i = 0; i < st.size(); ++i) {
       const std::string p = "stages[" + std::to_string(i) + "]";
       rd.only(st[i], p,
-              {"name", "duration", "hold", "remove_walls", "until_rms_speed", "until_max_speed", "check_every"});
+              {"name", "duration", "hold", "remove_walls", "until_rms_speed", "until_max_speed", "check_every",
+               "gravity", "gravity_ramp", "trim_above"});
       Stage s;
       s.name = rd.text(st[i], p, "name", "stage" + std::to_string(i));
       s.duration = rd.number(st[i], p, "duration", 0, 0, 1e9, true);
@@ -556,6 +737,16 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
       s.until_rms_speed = rd.number(st[i], p, "until_rms_speed", -1, -1, kInf);
       s.until_max_speed = rd.number(st[i], p, "until_max_speed", -1, -1, kInf);
       s.check_every = rd.number(st[i], p, "check_every", 0.01, 0, kInf, true);
+      if (st[i]["gravity"]) {
+        s.set_gravity = true;
+        s.gravity = rd.vec3(st[i], p, "gravity", Vec3::Zero(), true);
+      }
+      s.gravity_ramp = rd.number(st[i], p, "gravity_ramp", 0, 0, s.duration);
+      if (s.gravity_ramp > 0 && !s.set_gravity) rd.fail(p + ".gravity_ramp", "needs a 'gravity' to ramp to");
+      if (st[i]["trim_above"]) {
+        s.trim = true;
+        s.trim_above = rd.number(st[i], p, "trim_above", 0, -kInf, kInf);
+      }
       sc.stages.push_back(s);
     }
   } else {

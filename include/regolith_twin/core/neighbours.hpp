@@ -14,6 +14,15 @@ bool lists_need_rebuild(const Model& m, const State& s);
 // fixed partition of the rows used by the force pass.
 void build_neighbour_lists(const Model& m, State& s);
 
+// True when the grain–body list may have missed a contact: grain plus body
+// displacement since its build exceeds the skin. Rebuilt with the other
+// lists, and on its own when only bodies moved (a fast impactor).
+bool body_list_needs_rebuild(const Model& m, const State& s);
+void build_body_list(const Model& m, State& s);
+// Split the grain–body entries into the fixed work partitions (done by every
+// build; needed again after a checkpoint restores the list).
+void partition_body_list(const Model& m, State& s);
+
 // Recompute the per-entry constants and the fixed work partition of the
 // current lists (done by every build; needed again only after lists are
 // restored from a checkpoint).

@@ -21,6 +21,7 @@ struct StageReport {
   std::string name;
   double t_end = 0;         // simulated time at the end of the stage, s
   std::string reason;       // "duration" or "criteria"
+  int grains_removed = 0;   // by the stage's trim
 };
 
 struct RunReport {
@@ -34,6 +35,8 @@ struct RunReport {
   std::vector<StageReport> stages;
 };
 
-RunReport run_scenario(const Scenario& sc, State& s, const RunOptions& opt);
+// Stages may change the scenario's model (gravity, trimmed grains), so the
+// scenario is taken by reference and left as the last stage had it.
+RunReport run_scenario(Scenario& sc, State& s, const RunOptions& opt);
 
 }  // namespace rt

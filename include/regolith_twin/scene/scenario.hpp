@@ -32,6 +32,11 @@ struct Stage {
   double until_rms_speed = -1;        // end early once RMS grain speed is below this, m/s (<0: off)
   double until_max_speed = -1;        // ... and the max grain speed below this, m/s (<0: off)
   double check_every = 0.01;          // s between checks of the criteria
+  bool set_gravity = false;           // change gravity at the start of the stage
+  Vec3 gravity = Vec3::Zero();        // new gravity, m/s^2
+  double gravity_ramp = 0;            // s over which gravity moves geometrically to the new value (0: at once)
+  bool trim = false;                  // remove grains at the start of the stage
+  double trim_above = 0;              // ... whose centre lies above this height (z), m
 };
 
 struct Scenario {
@@ -56,6 +61,11 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
 // Interpret an already parsed document; `source` names it in error messages.
 Scenario parse_scenario(const YAML::Node& root, const std::string& source);
 Scenario parse_scenario_text(const std::string& yaml_text, const std::string& source = "<string>");
+
+// Remove the grains flagged in `drop` from the scenario's model and from the
+// state (kinematics kept; contact lists rebuilt at the next step, so springs
+// start afresh). Grain groups shrink accordingly. Returns the number removed.
+int remove_grains(Scenario& sc, State& s, const std::vector<uint8_t>& drop);
 
 // Published materials (MODEL.md §9): gravel, moderate, glass_beads, glass_beads_b.
 bool material_preset(const std::string& name, Material& out);

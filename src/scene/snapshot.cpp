@@ -1,0 +1,79 @@
+// Compact float32 bed snapshots (see snapshot.hpp).
+#include "regolith_twin/scene/snapshot.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+
+namespace rt {
+namespace {
+
+constexpr char kMagic[8] = {'R', 'G', 'T', 'W', 'B', 'E', 'D', '1'};
+
+uint64_t fnv1a(const char* p, size_t n) {
+  uint64_t h = 1469598103934665603ULL;
+  for (size_t i = 0; i < n; ++i) {
+    h ^= static_cast<unsigned char>(p[i]);
+    h *= 1099511628211ULL;
+  }
+  return h;
+}
+
+}  // namespace
+
+void write_snapshot(const std::string& path, const Model& m, const State& s, bool include_fixed) {
+  std::string buf(kMagic, sizeof kMagic);
+  uint64_t n = 0;
+  for (int i = 0; i < m.n_grains; ++i) n += include_fixed || !m.grain_fixed[i];
+  buf.append(reinterpret_cast<const char*>(&n), sizeof n);
+  for (int i = 0; i < m.n_grains; ++i) {
+    if (!include_fixed && m.grain_fixed[i]) continue;
+    const float rec[4] = {float(s.pos[i].x()), float(s.pos[i].y()), float(s.pos[i].z()), float(m.grain_radius[i])};
+    buf.append(reinterpret_cast<const char*>(rec), sizeof rec);
+  }
+  const uint64_t sum = fnv1a(buf.data(), buf.size());
+  buf.append(reinterpret_cast<const char*>(&sum), sizeof sum);
+  const std::string tmp = path + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) throw InputError(path + ": cannot write snapshot");
+  const bool ok = std::fwrite(buf.data(), 1, buf.size(), f) == buf.size() && std::fflush(f) == 0 &&
+                  ::fsync(fileno(f)) == 0;
+  if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw InputError(path + ": could not write snapshot");
+  }
+}
+
+bool is_snapshot(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[8] = {};
+  return in.read(head, 8) && std::memcmp(head, kMagic, 8) == 0;
+}
+
+std::vector<SnapshotGrain> read_snapshot(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) throw InputError(path + ": cannot open bed snapshot");
+  std::string data(static_cast<size_t>(in.tellg()), '\0');
+  in.seekg(0);
+  if (!in.read(data.data(), data.size())) throw InputError(path + ": cannot read bed snapshot");
+  auto fail = [&](const std::string& what) { throw InputError(path + ": not a usable bed snapshot: " + what); };
+  if (data.size() < 24 || std::memcmp(data.data(), kMagic, 8) != 0) fail("wrong file type (no snapshot header)");
+  uint64_t n = 0, sum = 0;
+  std::memcpy(&n, data.data() + 8, 8);
+  if (n > (data.size() - 24) / 16 || data.size() != 24 + 16 * n) fail("truncated file (length does not match the grain count)");
+  std::memcpy(&sum, data.data() + data.size() - 8, 8);
+  if (fnv1a(data.data(), data.size() - 8) != sum) fail("checksum mismatch (corrupted file)");
+  std::vector<SnapshotGrain> out(n);
+  for (uint64_t i = 0; i < n; ++i) {
+    float rec[4];
+    std::memcpy(rec, data.data() + 16 + 16 * i, 16);
+    out[i].pos = Vec3(rec[0], rec[1], rec[2]);
+    out[i].radius = rec[3];
+    if (!(out[i].radius > 0) || !out[i].pos.allFinite()) fail("grain " + std::to_string(i) + " has an invalid radius or position");
+  }
+  return out;
+}
+
+}  // namespace rt

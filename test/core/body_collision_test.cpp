@@ -10,6 +10,7 @@
 #include <string>
 
 #include "regolith_twin/core/body_collision.hpp"
+#include "regolith_twin/core/step.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -277,33 +278,6 @@ TEST(BodyCollision, AFaceOnAFaceKeepsFourPoints) {
 
 // --- (b) restitution of impacts ------------------------------------------------------
 
-// Kick–drift–kick for the bodies alone (free rotation between half kicks).
-void local_step(const Model& m, State& s) {
-  const double h = m.dt;
-  for (size_t i = 0; i < s.bodies.size(); ++i) {
-    const BodyModel& bm = m.bodies[i];
-    BodyState& b = s.bodies[i];
-    if (bm.fixed) continue;
-    const Vec3 acc = b.force / bm.mass + m.gravity;
-    b.vel_mid = b.vel + 0.5 * h * acc;
-    b.ang_mom += 0.5 * h * b.torque;
-    b.pos += h * b.vel_mid;
-    b.q = rt::free_rotation(bm.inertia, b.q, b.ang_mom, h);
-    b.omega_mid = rt::inverse_inertia_world(bm, b.q) * b.ang_mom;
-    b.vel = b.vel_mid + 0.5 * h * acc;  // predicted with the last force
-    b.omega = rt::inverse_inertia_world(bm, b.q) * (b.ang_mom + 0.5 * h * b.torque);
-  }
-  forces(m, s);
-  for (size_t i = 0; i < s.bodies.size(); ++i) {
-    const BodyModel& bm = m.bodies[i];
-    BodyState& b = s.bodies[i];
-    if (bm.fixed) continue;
-    b.vel = b.vel_mid + 0.5 * h * (b.force / bm.mass + m.gravity);
-    b.ang_mom += 0.5 * h * b.torque;
-    b.omega = rt::inverse_inertia_world(bm, b.q) * b.ang_mom;
-  }
-}
-
 TEST(BodyCollision, HeadOnSphereSphereReproducesRestitution) {
   for (double eps : {0.3, 0.6, 0.9}) {
     const double kn = 1e5, m1 = 1.0, m2 = 2.0, r = 0.1;
@@ -316,10 +290,9 @@ TEST(BodyCollision, HeadOnSphereSphereReproducesRestitution) {
     const Vec3 u0(1.0, 0, 0);
     rt::set_body_velocity(m.bodies[0], s.bodies[0], u0 * (m2 / (m1 + m2)), Vec3::Zero());
     rt::set_body_velocity(m.bodies[1], s.bodies[1], -u0 * (m1 / (m1 + m2)), Vec3::Zero());
-    forces(m, s);
     bool touched = false;
     for (int k = 0; k < 2000; ++k) {
-      local_step(m, s);
+      rt::step(m, s);
       touched = touched || s.stats.body_body_contacts > 0;
       if (touched && s.stats.body_body_contacts == 0) break;
     }
@@ -342,11 +315,10 @@ TEST(BodyCollision, FaceDownBoxImpactReproducesRestitutionWithFourPoints) {
     place(m, s, 0, Vec3::Zero());
     place(m, s, 1, Vec3(0, 0, h.z() + 1e-4), Quat(Eigen::AngleAxisd(0.5, Vec3::UnitZ())));
     rt::set_body_velocity(m.bodies[1], s.bodies[1], Vec3(0, 0, -1), Vec3::Zero());
-    forces(m, s);
     bool touched = false;
     long max_points = 0, min_points = 100;
     for (int k = 0; k < 2000; ++k) {
-      local_step(m, s);
+      rt::step(m, s);
       const long n = s.stats.body_body_contacts;
       if (n > 0) {
         touched = true;
@@ -395,13 +367,12 @@ DropResult drop(double eps, double mu, const Quat& q) {
   const double low = (R.row(2).transpose().cwiseAbs().cwiseProduct(h)).sum();  // centre above the lowest corner
   place(m, s, 1, Vec3(0.1, -0.05, low + 0.01), q);
   rt::set_body_velocity(m.bodies[1], s.bodies[1], Vec3(0, 0, -1), Vec3::Zero());
-  forces(m, s);
   const double e_in = body_energy(m, s, 1);
   DropResult r;
   bool touched = false, left = false;
   const long steps = static_cast<long>(0.15 / m.dt);
   for (long k = 0; k < steps; ++k) {
-    local_step(m, s);
+    rt::step(m, s);
     const long n = s.stats.body_body_contacts;
     r.max_points = std::max(r.max_points, n);
     if (n > 0) {
@@ -446,6 +417,35 @@ TEST(BodyCollision, BoxDroppedAtRandomAttitudesNeverLeavesWithMoreEnergy) {
   ::testing::Test::RecordProperty("elastic_energy_error", rt::test::figure(worst_elastic));
   std::printf("eps 0.6 mu 0.5: max E_out/E_in first departure %.6f, any contact-free instant %.6f; "
               "eps 1 mu 0: max |E/E_in - 1| %.3e\n", worst_first, worst_any, worst_elastic);
+}
+
+}  // namespace
+
+namespace {
+
+// The narrow phase keeps nothing between steps: a copy of the State taken in
+// the middle of a contact continues bit-identically to the original.
+TEST(BodyCollision, CopiedStateContinuesBitIdentically) {
+  const Vec3 h(0.3, 0.2, 0.1);
+  Model m = make_model({plate(), box(h)}, 0.6, 0.5, 1e7, 2e-5);
+  m.gravity = Vec3(0, 0, -9.81);
+  State s = body_state(m);
+  place(m, s, 0, Vec3::Zero());
+  const Quat q(Eigen::AngleAxisd(0.3, Vec3(1, 2, 0).normalized()));
+  const Mat3 R = q.toRotationMatrix();
+  place(m, s, 1, Vec3(0, 0, (R.row(2).transpose().cwiseAbs().cwiseProduct(h)).sum() + 1e-3), q);
+  rt::set_body_velocity(m.bodies[1], s.bodies[1], Vec3(0.3, 0, -1), Vec3(0, 0, 2));
+  while (s.body_points.empty()) rt::step(m, s);
+  for (int k = 0; k < 20; ++k) rt::step(m, s);
+  ASSERT_FALSE(s.body_points.empty());
+  State copy = s;
+  for (int k = 0; k < 400; ++k) {
+    rt::step(m, s);
+    rt::step(m, copy);
+  }
+  EXPECT_EQ(s.bodies[1].pos, copy.bodies[1].pos);
+  EXPECT_EQ(s.bodies[1].q.coeffs(), copy.bodies[1].q.coeffs());
+  EXPECT_EQ(s.bodies[1].ang_mom, copy.bodies[1].ang_mom);
 }
 
 }  // namespace

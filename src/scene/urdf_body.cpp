@@ -326,6 +326,7 @@ class Loader {
     };
     std::vector<Part> parts;
     std::string massive;  // names of the links with mass, for messages
+    int n_massive = 0;
     double M = 0;
     Vec3 mc = Vec3::Zero();
     for (const LinkInfo& li : links_) {
@@ -346,7 +347,10 @@ class Loader {
       parts.push_back({in->mass, p.p, R * I * R.transpose()});
       M += in->mass;
       mc += in->mass * p.p;
-      if (in->mass > 0) massive += (massive.empty() ? "'" : ", '") + name + "'";
+      if (in->mass > 0) {
+        massive += (massive.empty() ? "'" : ", '") + name + "'";
+        ++n_massive;
+      }
     }
     if (!(M > 0))
       fail("total mass is " + num(M) + " kg: must be > 0 kg (root link '" + model_->getRoot()->name +
@@ -370,8 +374,8 @@ class Loader {
     }
     const Vec3 lam = Eigen::SelfAdjointEigenSolver<Mat3>(I, Eigen::EigenvaluesOnly).eigenvalues();
     if (!(lam[0] > 1e-12 * lam[2]))
-      fail("inertia tensor of links " + massive + " merged about the centre of mass is not positive definite " +
-           "(principal moments " + vec_text(lam) + " kg m^2)");
+      fail((n_massive == 1 ? "link " + massive + ": inertia tensor" : "inertia tensor of links " + massive + " merged") +
+           " about the centre of mass is not positive definite (principal moments " + vec_text(lam) + " kg m^2)");
     mass_ = M;
     com_ = c;
     inertia_ = I;
@@ -538,6 +542,18 @@ TriangleMesh load_stl(const std::string& path, const Vec3& scale) {
     mesh.triangles.push_back(tri);
   }
   if (mesh.triangles.empty()) stl_fail(path, "STL file has only degenerate facets");
+  // Keep only the vertices of the remaining facets, in order of first use.
+  std::vector<int> renumber(mesh.vertices.size(), -1);
+  std::vector<Vec3> used;
+  for (auto& tri : mesh.triangles)
+    for (int& v : tri) {
+      if (renumber[v] < 0) {
+        renumber[v] = static_cast<int>(used.size());
+        used.push_back(mesh.vertices[v]);
+      }
+      v = renumber[v];
+    }
+  mesh.vertices = std::move(used);
   return mesh;
 }
 

@@ -309,6 +309,36 @@ TEST_F(UrdfBody, OffDiagonalInertiaAndAxisOrder) {
   EXPECT_NEAR(R(2, 2), 1.0, 1e-12);
 }
 
+TEST_F(UrdfBody, PrincipalAxesMatchedToRootAxes) {
+  // diag(1, 2, 2.5) turned 80 deg about z: the axis of moment 1 lies nearest
+  // root y, that of moment 2 nearest root x (pointing along +x).
+  const double t = 80 * kPi / 180;
+  const std::string turned = write_urdf("turned.urdf", R"(<link name="l">
+    <inertial><origin rpy="0 0 1.3962634015954636"/><mass value="1"/>
+      <inertia ixx="1" ixy="0" ixz="0" iyy="2" iyz="0" izz="2.5"/></inertial>
+    <collision><geometry><sphere radius="0.1"/></geometry></collision></link>)");
+  const BodyModel b = rt::load_urdf_body(turned);
+  expect_vec_near(b.inertia, Vec3(2, 1, 2.5), 1e-12, "moments");
+  const Mat3 R = b.ref_rot.toRotationMatrix();
+  expect_vec_near(R.col(0), Vec3(std::sin(t), -std::cos(t), 0), 1e-12, "body x");
+  expect_vec_near(R.col(1), Vec3(std::cos(t), std::sin(t), 0), 1e-12, "body y");
+  expect_vec_near(R.col(2), Vec3::UnitZ(), 1e-12, "body z");
+
+  // Symmetric top diag(1, 1, 1.5) turned 30 deg about x: the symmetry axis is
+  // body z; root x, already in the symmetric plane, stays body x.
+  const double s = 30 * kPi / 180;
+  const std::string top = write_urdf("top.urdf", R"(<link name="l">
+    <inertial><origin rpy="0.5235987755982988 0 0"/><mass value="1"/>
+      <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1.5"/></inertial>
+    <collision><geometry><sphere radius="0.1"/></geometry></collision></link>)");
+  const BodyModel c = rt::load_urdf_body(top);
+  expect_vec_near(c.inertia, Vec3(1, 1, 1.5), 1e-12, "moments");
+  const Mat3 Q = c.ref_rot.toRotationMatrix();
+  expect_vec_near(Q.col(0), Vec3::UnitX(), 1e-12, "body x");
+  expect_vec_near(Q.col(2), Vec3(0, -std::sin(s), std::cos(s)), 1e-12, "body z");
+  EXPECT_NEAR(Q.determinant(), 1.0, 1e-14);
+}
+
 // ------------------------------------------------------------------ meshes ---
 
 TEST_F(UrdfBody, StlBinaryAndAscii) {
@@ -329,6 +359,14 @@ TEST_F(UrdfBody, StlBinaryAndAscii) {
     // A mirroring scale keeps the winding outward.
     EXPECT_NEAR(mesh_volume(rt::load_stl(file, Vec3(-2, 1, 1))), 2.0, 1e-12);
   }
+  // A degenerate facet is dropped together with the vertex only it used.
+  auto with_sliver = facets;
+  with_sliver.push_back({Vec3(9, 9, 9), Vec3(9, 9, 9), Vec3(0.5, 0.5, 0.5)});
+  const rt::TriangleMesh sliver = rt::load_stl(write("meshes/sliver.stl", ascii_stl(with_sliver)));
+  EXPECT_EQ(sliver.vertices.size(), 8u);
+  EXPECT_EQ(sliver.triangles.size(), 12u);
+  EXPECT_NEAR(mesh_volume(sliver), 1.0, 1e-15);
+
   // A truncated binary file with no ASCII header.
   std::string broken = binary_stl(facets);
   broken.replace(0, 5, "cubes");

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "regolith_twin/core/body_collision.hpp"
 #include "regolith_twin/core/contact_law.hpp"
 #include "regolith_twin/core/walls.hpp"
 
@@ -67,6 +68,7 @@ Energy energy(const Model& m, const State& s) {
   if (s.lists_valid)
     e.elastic = m.contact_model == ContactModel::Linear ? elastic_energy<ContactModel::Linear>(m, s)
                                                         : elastic_energy<ContactModel::HertzMindlin>(m, s);
+  e.elastic += body_body_elastic_energy(m, s);  // body–body points of the last force pass
   return e;
 }
 

@@ -5,6 +5,8 @@
 
 #include "regolith_twin/core/model.hpp"
 
+#include "regolith_twin/core/body_collision.hpp"
+
 namespace rt {
 namespace {
 
@@ -160,6 +162,7 @@ void finalize_model(Model& m) {
       m.pair_law[a * nm + b] = L;
     }
   if (m.skin <= 0) m.skin = 0.5 * m.max_radius;
+  build_body_geometry(m);
 }
 
 std::vector<PairResolution> pair_resolution(const Model& m, double v_ref) {

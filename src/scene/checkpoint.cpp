@@ -194,7 +194,9 @@ State load_checkpoint(const std::string& path, const Model& m) {
           bl.shape[k] < 0 || bl.shape[k] >= int(m.bodies[bl.body[k]].shapes.size()))
         r.fail("grain–body list refers to a grain, body or shape that does not exist");
     for (const auto& pt : s.body_points)
-      if (pt.a < 0 || pt.b < 0 || pt.a >= int(nb) || pt.b >= int(nb)) r.fail("body contact refers to a missing body");
+      if (pt.a < 0 || pt.b < 0 || pt.a >= int(nb) || pt.b >= int(nb) || pt.shape_a < 0 || pt.shape_b < 0 ||
+          pt.shape_a >= int(m.bodies[pt.a].shapes.size()) || pt.shape_b >= int(m.bodies[pt.b].shapes.size()))
+        r.fail("body contact refers to a missing body or shape");
   } else if (!m.bodies.empty()) {
     r.fail("format version 2 holds no bodies, the scenario has " + std::to_string(m.bodies.size()));
   }

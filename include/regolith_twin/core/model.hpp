@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -86,6 +87,9 @@ struct Guards {
   bool allow_under_resolved = false;
 };
 
+// Bullet collision objects of the bodies' shapes (defined in body_collision.cpp).
+struct BodyGeometry;
+
 struct Model {
   // --- grains (indexed by grain id; the State keeps its own sorted copies) ---
   int n_grains = 0;
@@ -106,6 +110,15 @@ struct Model {
   // --- environment ---
   std::vector<Wall> walls;
   std::vector<BodyModel> bodies;       // rigid bodies (MODEL.md §6)
+  double body_kn = 0;                  // body–body normal stiffness of one shape pair, N/m (<= 0: the scene k_n);
+                                       // k_t, C_n, C_t of body–body contacts scale with it (MODEL.md §6)
+  // Bullet shapes of every body shape for the body–body narrow phase: built by
+  // build_body_geometry() (called from finalize_model, and lazily by
+  // body_body_forces if missing or out of date). Shared by copies of the Model;
+  // a cache, not part of the description. It holds scratch used during a
+  // query, so a Model and its copies must run body_body_forces on one thread
+  // at a time (a concurrent call throws std::logic_error).
+  mutable std::shared_ptr<BodyGeometry> body_geometry;
   Vec3 gravity = Vec3(0, 0, -9.81);    // m/s^2
 
   // --- integration ---

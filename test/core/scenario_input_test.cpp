@@ -337,7 +337,7 @@ std::string huge_dt_scene() {
 
 // Runs the scenario at `path` and checks the blow-up report and outputs.
 void expect_blow_up(const std::string& path, const std::string& out_dir, const std::string& must_mention) {
-  const rt::Scenario sc = rt::load_scenario(path);
+  rt::Scenario sc = rt::load_scenario(path);
   rt::State s = sc.initial;
   rt::RunOptions opt;
   opt.out_dir = out_dir;

@@ -150,11 +150,18 @@ struct alignas(64) ContactBlock {
 };
 
 // pair_contact<M, false> for records [0, nb) of a block. Law constants:
-// linear c0..c3 = kn, kt, cn_coef, ct_coef; Hertz–Mindlin c0..c2 = E*, G*, hm_damp.
-template <ContactModel M>
-void evaluate_block(ContactBlock& b, int nb, double dt) {
+// linear c0..c3 = kn, kt, cn_coef, ct_coef; Hertz–Mindlin c0..c2 = E*, G*, hm_damp;
+// per record, or the same for all (Uniform: every grain has one material).
+template <ContactModel M, bool Uniform>
+void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_law) {
+  const double u0 = M == ContactModel::Linear ? uniform_law.kn : uniform_law.e_star;
+  const double u1 = M == ContactModel::Linear ? uniform_law.kt : uniform_law.g_star;
+  const double u2 = M == ContactModel::Linear ? uniform_law.cn_coef : uniform_law.hm_damp;
+  const double u3 = uniform_law.ct_coef, umu = uniform_law.mu_s;
 #pragma omp simd
   for (int c = 0; c < nb; ++c) {
+    const double c0 = Uniform ? u0 : b.c0[c], c1 = Uniform ? u1 : b.c1[c], c2 = Uniform ? u2 : b.c2[c],
+                 c3 = Uniform ? u3 : b.c3[c], mu = Uniform ? umu : b.mu[c];
     // Geometry (pair_rows).
     const double dist2 = b.dist2[c];
     const double inv_dist = 1.0 / std::sqrt(dist2);
@@ -165,17 +172,17 @@ void evaluate_block(ContactBlock& b, int nb, double dt) {
     // law_terms
     double fn_el, kt, cn, ct;
     if constexpr (M == ContactModel::Linear) {
-      fn_el = b.c0[c] * x;
-      kt = b.c1[c];
-      cn = b.c2[c] * sm;
-      ct = b.c3[c] * sm;
+      fn_el = c0 * x;
+      kt = c1;
+      cn = c2 * sm;
+      ct = c3 * sm;
     } else {
       const double reff = b.ri[c] * b.rj[c] / b.rs[c];
       const double a = std::sqrt(reff * x);
-      const double kn_eff = 2.0 * b.c0[c] * a;
+      const double kn_eff = 2.0 * c0 * a;
       fn_el = (2.0 / 3.0) * kn_eff * x;
-      kt = 8.0 * b.c1[c] * a;
-      cn = b.c2[c] * std::sqrt(kn_eff) * sm;
+      kt = 8.0 * c1 * a;
+      cn = c2 * std::sqrt(kn_eff) * sm;
       ct = cn;
     }
     // Contact-point velocities: u = vrel - (lj wj + li wi) x n, normal and tangential parts.
@@ -211,7 +218,7 @@ void evaluate_block(ContactBlock& b, int nb, double dt) {
       sz = keep ? sz : scale ? qz : pz;
     }
     // detail::slider with k = kt, c = ct, cap = mu_s fn.
-    const double cap = b.mu[c] * fn;
+    const double cap = mu * fn;
     const double cap2 = cap * cap;
     sx += mtx * dt;
     sy += mty * dt;
@@ -262,10 +269,10 @@ struct RowSums {
 };
 
 // Evaluate a block and add its results in list order, as pair_rows does.
-template <ContactModel M>
-void flush_block(ContactBlock& b, int nb, double dt, const double* __restrict radius, PairList& pl,
-                 Vec3* __restrict F, Vec3* __restrict T, RowSums& r) {
-  evaluate_block<M>(b, nb, dt);
+template <ContactModel M, bool Uniform>
+void flush_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_law, PairList& pl, Vec3* __restrict F,
+                 Vec3* __restrict T, RowSums& r) {
+  evaluate_block<M, Uniform>(b, nb, dt, uniform_law);
   Vec3* __restrict spring = pl.spring_t.data();
   for (int c = 0; c < nb; ++c) {
     spring[b.k[c]] = Vec3(b.sx[c], b.sy[c], b.sz[c]);
@@ -292,10 +299,11 @@ void flush_block(ContactBlock& b, int nb, double dt, const double* __restrict ra
   }
 }
 
-template <ContactModel M>
+template <ContactModel M, bool Uniform>
 void pair_rows_batched(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec3* __restrict T,
                        ThreadScratch& sc) {
   PairList& pl = s.pairs;
+  const PairLaw& uniform_law = m.pair_law[Uniform ? m.single_grain_material * (m.n_materials() + 1) : 0];
   const double dt = m.dt;
   const int nm = m.n_materials();
   const Vec3* __restrict pos = s.pos.data();
@@ -370,27 +378,29 @@ void pair_rows_batched(const Model& m, State& s, int rb, int re, Vec3* __restric
       b.sx[nb] = sp.x();
       b.sy[nb] = sp.y();
       b.sz[nb] = sp.z();
-      const PairLaw& law = laws[material[j]];
-      if constexpr (M == ContactModel::Linear) {
-        b.c0[nb] = law.kn;
-        b.c1[nb] = law.kt;
-        b.c2[nb] = law.cn_coef;
-        b.c3[nb] = law.ct_coef;
-      } else {
-        b.c0[nb] = law.e_star;
-        b.c1[nb] = law.g_star;
-        b.c2[nb] = law.hm_damp;
-        b.c3[nb] = 0;
+      if constexpr (!Uniform) {
+        const PairLaw& law = laws[material[j]];
+        if constexpr (M == ContactModel::Linear) {
+          b.c0[nb] = law.kn;
+          b.c1[nb] = law.kt;
+          b.c2[nb] = law.cn_coef;
+          b.c3[nb] = law.ct_coef;
+        } else {
+          b.c0[nb] = law.e_star;
+          b.c1[nb] = law.g_star;
+          b.c2[nb] = law.hm_damp;
+          b.c3[nb] = 0;
+        }
+        b.mu[nb] = law.mu_s;
       }
-      b.mu[nb] = law.mu_s;
       ++contacts;
       if (++nb == kBlock) {
-        flush_block<M>(b, nb, dt, radius, pl, F, T, r);
+        flush_block<M, Uniform>(b, nb, dt, uniform_law, pl, F, T, r);
         nb = 0;
       }
     }
   }
-  if (nb) flush_block<M>(b, nb, dt, radius, pl, F, T, r);
+  if (nb) flush_block<M, Uniform>(b, nb, dt, uniform_law, pl, F, T, r);
   if (r.i >= 0) {
     F[r.i] += r.fi;
     T[r.i] += r.ti;
@@ -472,23 +482,35 @@ void force_pass(const Model& m, State& s) {
       const int lo = p == 0 ? 0 : sc.touched_lo, hi = p == 0 ? n : sc.touched_hi;
       std::fill(F + lo, F + hi, Vec3::Zero());
       std::fill(T + lo, T + hi, Vec3::Zero());
-      if (!Resist && !s.log_contacts && !s.scalar_kernel)
-        pair_rows_batched<M>(m, s, s.thread_row_begin[p], s.thread_row_begin[p + 1], F, T, sc);
+      const int rb = s.thread_row_begin[p], re = s.thread_row_begin[p + 1];
+      if (!Resist && !s.log_contacts && !s.scalar_kernel && m.single_grain_material >= 0)
+        pair_rows_batched<M, true>(m, s, rb, re, F, T, sc);
+      else if (!Resist && !s.log_contacts && !s.scalar_kernel)
+        pair_rows_batched<M, false>(m, s, rb, re, F, T, sc);
       else
         pair_rows<M, Resist>(m, s, s.thread_row_begin[p], s.thread_row_begin[p + 1], F, T, sc);
     }
 #pragma omp barrier
-    // Merge partition buffers in partition order.
-#pragma omp for schedule(static)
-    for (int i = 0; i < n; ++i) {
+    // Merge partition buffers in partition order: each thread takes a block
+    // of grains and adds, partition after partition, the part of each
+    // buffer's written range inside it (every grain still sums in partition
+    // order, whatever the thread count).
+    {
+      const int gb = int(long(n) * tid / nt), ge = int(long(n) * (tid + 1) / nt);
+      Vec3* __restrict force = s.force.data();
+      Vec3* __restrict torque = s.torque.data();
       for (int p = 1; p < P; ++p) {
         const ThreadScratch& sc = s.scratch[p];
-        if (i >= sc.touched_lo && i < sc.touched_hi) {
-          s.force[i] += sc.force[i];
-          s.torque[i] += sc.torque[i];
+        const Vec3* __restrict pf = sc.force.data();
+        const Vec3* __restrict pt = sc.torque.data();
+        const int lo = std::max(gb, sc.touched_lo), hi = std::min(ge, sc.touched_hi);
+        for (int i = lo; i < hi; ++i) {
+          force[i] += pf[i];
+          torque[i] += pt[i];
         }
       }
     }
+#pragma omp barrier
     // Wall contacts: partitions split at grain boundaries, so no two write one grain.
     // Contact counts of walls go to a separate total.
     for (int p = tid; p < P; p += nt) {

@@ -1,9 +1,9 @@
 // The batched grain–grain kernel (forces.cpp, used when no pair type has
 // rolling or twisting resistance) must reproduce the one-pair-at-a-time
-// kernel bit for bit: same springs, forces, overlaps and trajectories. Two
-// grain materials (so the law table is gathered per pair), walls, impacts,
-// sliding contacts that hit the Coulomb cap, contacts that end and list
-// rebuilds; linear and Hertz–Mindlin laws.
+// kernel bit for bit: same springs, forces, overlaps and trajectories. One
+// grain material (law constants shared by the whole block) or two (gathered
+// per pair), walls, impacts, contacts that end and list rebuilds; linear and
+// Hertz–Mindlin laws.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -28,7 +28,7 @@ struct Scene {
   rt::State s;
 };
 
-Scene make_scene(rt::ContactModel law) {
+Scene make_scene(rt::ContactModel law, bool two_materials = true) {
   Scene sc;
   rt::Model& m = sc.m;
   m.contact_model = law;
@@ -57,7 +57,7 @@ Scene make_scene(rt::ContactModel law) {
   box.hi = Vec3(L, L, 1.0);
   const std::vector<Vec3> sites = rt::lattice_sites(box, 2.0001 * d.max(), d.max(), 0.0, kGrains, rng);
   const std::vector<double> radii = rt::draw_radii(d, kGrains, rng);
-  for (int i = 0; i < kGrains; ++i) rt::add_grain(m, radii[i], i % 3 == 0 ? 1 : 0);
+  for (int i = 0; i < kGrains; ++i) rt::add_grain(m, radii[i], two_materials && i % 3 == 0 ? 1 : 0);
   const double m_p = 4.0 / 3.0 * M_PI * std::pow(d.mean, 3) * a.density;
   m.kn = rt::kn_rule(m_p, 1.0, 0.01 * d.mean * (1 - d.sigma));
   m.dt = rt::dt_rule(m_p, m.kn, 30);
@@ -80,9 +80,10 @@ bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
 
 // Runs the scene with the batched and with the scalar kernel side by side and
 // compares every evolving quantity after each block of steps.
-void compare_kernels(rt::ContactModel law, int steps) {
-  Scene batched = make_scene(law), scalar = make_scene(law);
+void compare_kernels(rt::ContactModel law, bool two_materials, int steps) {
+  Scene batched = make_scene(law, two_materials), scalar = make_scene(law, two_materials);
   ASSERT_FALSE(batched.m.any_resistance);
+  ASSERT_EQ(batched.m.single_grain_material, two_materials ? -1 : 0);
   scalar.s.scalar_kernel = true;
   long contacts = 0, capped = 0;
   for (int k = 1; k <= steps; ++k) {
@@ -113,9 +114,17 @@ void compare_kernels(rt::ContactModel law, int steps) {
 
 }  // namespace
 
-TEST(BatchedKernel, LinearMatchesScalarBitForBit) { compare_kernels(rt::ContactModel::Linear, 3000); }
+TEST(BatchedKernel, LinearOneMaterialMatchesScalarBitForBit) {
+  compare_kernels(rt::ContactModel::Linear, false, 3000);
+}
 
-TEST(BatchedKernel, HertzMindlinMatchesScalarBitForBit) { compare_kernels(rt::ContactModel::HertzMindlin, 3000); }
+TEST(BatchedKernel, LinearTwoMaterialsMatchesScalarBitForBit) {
+  compare_kernels(rt::ContactModel::Linear, true, 3000);
+}
+
+TEST(BatchedKernel, HertzMindlinTwoMaterialsMatchesScalarBitForBit) {
+  compare_kernels(rt::ContactModel::HertzMindlin, true, 3000);
+}
 
 TEST(BatchedKernel, TwoThreadsMatchOneThread) {
   Scene one = make_scene(rt::ContactModel::Linear), two = make_scene(rt::ContactModel::Linear);

@@ -119,15 +119,15 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec
 // Rows are walked as in pair_rows, but each touching pair is only gathered
 // into a block of structure-of-arrays records; a full block is evaluated by
 // one branch-free loop over its records, which the compiler vectorises (4
-// pairs per instruction with AVX2 under -march=native, plain scalar code on
-// any other target), and the results are then added to the force arrays in
+// pairs per instruction with AVX2 under -march=native, 2 with SSE2 in a
+// portable build; plain C++, no intrinsics), and the results are then added to the force arrays in
 // list order. Every record goes through the same IEEE operations in the same
 // order as pair_contact (the branches of the spring rotation and of the
 // Coulomb caps become selects), and the sums are formed in the same order as
 // in pair_rows, so both kernels give bit-identical results
 // (test/core/batched_kernel_test.cpp).
 
-constexpr int kBlock = 32;  // records per block: 47 arrays of 32 doubles stay in L1
+constexpr int kBlock = 32;  // records per block: 44 arrays of 32 doubles (11 kB) stay in L1
 
 struct alignas(64) ContactBlock {
   // gathered

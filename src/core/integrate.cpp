@@ -11,27 +11,40 @@ namespace rt {
 void kick_drift(const Model& m, State& s, double h, double dt) {
   const int n = m.n_grains;
   const Vec3 g = m.gravity;
+  // Raw restrict pointers: a store through one array cannot change another's
+  // data pointer, so the loop does not reload them for every grain.
+  const double* __restrict inv_mass = m.grain_inv_mass.data();
+  const double* __restrict inv_inertia = m.grain_inv_inertia.data();
+  const Vec3* __restrict force = s.force.data();
+  const Vec3* __restrict torque = s.torque.data();
+  const Vec3* __restrict pos_at_build = s.pos_at_build.data();
+  Vec3* __restrict pos = s.pos.data();
+  Vec3* __restrict vel = s.vel.data();
+  Vec3* __restrict omega = s.omega.data();
+  Vec3* __restrict vel_mid = s.vel_mid.data();
+  Vec3* __restrict omega_mid = s.omega_mid.data();
   bool finite = true;
   double max_d2 = s.stats.max_disp2;
 #pragma omp parallel for schedule(static) reduction(&& : finite) reduction(max : max_d2) if (n >= m.parallel_min_grains)
   for (int i = 0; i < n; ++i) {
-    const double im = m.grain_inv_mass[i];
+    const double im = inv_mass[i];
     if (im == 0) {  // glued grain
-      s.vel_mid[i] = s.vel[i];
-      s.omega_mid[i] = s.omega[i];
+      vel_mid[i] = vel[i];
+      omega_mid[i] = omega[i];
       continue;
     }
-    const Vec3 dv = h * (s.force[i] * im + g);
-    const Vec3 dw = (h * m.grain_inv_inertia[i]) * s.torque[i];
-    const Vec3 v_mid = s.vel[i] + dv, w_mid = s.omega[i] + dw;
-    s.vel_mid[i] = v_mid;
-    s.omega_mid[i] = w_mid;
-    s.pos[i] += dt * v_mid;
-    s.vel[i] = v_mid + dv;    // predicted v(n+1) with a(n)
-    s.omega[i] = w_mid + dw;  // predicted omega(n+1)
+    const Vec3 dv = h * (force[i] * im + g);
+    const Vec3 dw = (h * inv_inertia[i]) * torque[i];
+    const Vec3 v_mid = vel[i] + dv, w_mid = omega[i] + dw;
+    vel_mid[i] = v_mid;
+    omega_mid[i] = w_mid;
+    const Vec3 x = pos[i] + dt * v_mid;
+    pos[i] = x;
+    vel[i] = v_mid + dv;    // predicted v(n+1) with a(n)
+    omega[i] = w_mid + dw;  // predicted omega(n+1)
     // NaN and inf both fail this comparison.
-    finite = finite && (v_mid.squaredNorm() + w_mid.squaredNorm() < 1e300);
-    max_d2 = std::max(max_d2, (s.pos[i] - s.pos_at_build[i]).squaredNorm());
+    finite = finite & (v_mid.squaredNorm() + w_mid.squaredNorm() < 1e300);
+    max_d2 = std::max(max_d2, (x - pos_at_build[i]).squaredNorm());
   }
   s.stats.finite = finite;
   s.stats.max_disp2 = max_d2;
@@ -40,14 +53,24 @@ void kick_drift(const Model& m, State& s, double h, double dt) {
 void finish_kick(const Model& m, State& s, double h) {
   const int n = m.n_grains;
   const Vec3 g = m.gravity;
+  const double* __restrict inv_mass = m.grain_inv_mass.data();
+  const double* __restrict inv_inertia = m.grain_inv_inertia.data();
+  const Vec3* __restrict force = s.force.data();
+  const Vec3* __restrict torque = s.torque.data();
+  const Vec3* __restrict vel_mid = s.vel_mid.data();
+  const Vec3* __restrict omega_mid = s.omega_mid.data();
+  Vec3* __restrict vel = s.vel.data();
+  Vec3* __restrict omega = s.omega.data();
   bool finite = true;
 #pragma omp parallel for schedule(static) reduction(&& : finite) if (n >= m.parallel_min_grains)
   for (int i = 0; i < n; ++i) {
-    const double im = m.grain_inv_mass[i];
+    const double im = inv_mass[i];
     if (im == 0) continue;
-    s.vel[i] = s.vel_mid[i] + h * (s.force[i] * im + g);
-    s.omega[i] = s.omega_mid[i] + (h * m.grain_inv_inertia[i]) * s.torque[i];
-    finite = finite && (s.vel[i].squaredNorm() + s.omega[i].squaredNorm() < 1e300);
+    const Vec3 v = vel_mid[i] + h * (force[i] * im + g);
+    const Vec3 w = omega_mid[i] + (h * inv_inertia[i]) * torque[i];
+    vel[i] = v;
+    omega[i] = w;
+    finite = finite & (v.squaredNorm() + w.squaredNorm() < 1e300);
   }
   s.stats.finite = finite;
 }

@@ -140,6 +140,9 @@ void finalize_model(Model& m) {
     m.max_radius = std::max(m.max_radius, r);
     m.min_radius = std::min(m.min_radius, r);
   }
+  m.single_grain_material = n ? m.grain_material[0] : -1;
+  for (int i = 1; i < n; ++i)
+    if (m.grain_material[i] != m.single_grain_material) m.single_grain_material = -1;
   for (const auto& w : m.walls)
     if (w.law_material < 0 || w.law_material >= nm) throw InputError("model: wall '" + w.name + "' has an unknown material");
   for (auto& b : m.bodies) {

@@ -129,6 +129,7 @@ struct Model {
                                        // bit-identical for any thread count <= partitions
   int parallel_min_grains = 3000;      // smaller scenes run on one thread (same result)
   bool any_resistance = false;         // some pair type has rolling or twisting resistance
+  int single_grain_material = -1;      // the material of every grain if they share one, else -1
   Guards guards;
 
   double max_radius = 0, min_radius = 0;  // extreme grain radii, m

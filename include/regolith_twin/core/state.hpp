@@ -145,6 +145,7 @@ struct State {
 
   StepStats stats;
   bool log_contacts = false;  // record every contact of each force pass in scratch[p].log
+  bool scalar_kernel = false;  // evaluate contacts one at a time (reference for the batched kernel)
 };
 
 // A state for model m: zero kinematics (callers set pos, vel, omega), every

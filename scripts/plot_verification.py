@@ -1,11 +1,13 @@
 #!/usr/bin/python3
 """Plot the collision verification tables written by regolith_verify.
 
-usage: plot_verification.py CSV_DIR PNG_DIR
+usage: plot_verification.py CSV_DIR PNG_DIR [REFERENCE_CSV]
 
 Reads restitution_convergence.csv, chung_ooi_test3.csv and chung_ooi_test4.csv
 from CSV_DIR and writes restitution_convergence.png, chung_ooi_test3.png and
-chung_ooi_test4.png into PNG_DIR.
+chung_ooi_test4.png into PNG_DIR. Test 4 is drawn against the measurements of
+Kharaz, Gorham & Salman (2001), read from REFERENCE_CSV (default
+docs/validation/kharaz2001_oblique_impact.csv; its header names the source).
 """
 import csv
 import os
@@ -19,7 +21,23 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 def read_csv(path):
     with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+        return list(csv.DictReader(line for line in f if not line.startswith("#")))
+
+
+DEFAULT_REFERENCE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "validation",
+                                 "kharaz2001_oblique_impact.csv")
+
+
+def read_reference(path):
+    """Measured test 4 curves: {quantity: ([incidence_deg], [value])}."""
+    out = {}
+    if not path or not os.path.exists(path):
+        return out
+    for r in read_csv(path):
+        xs, ys = out.setdefault(r["quantity"], ([], []))
+        xs.append(float(r["incidence_deg"]))
+        ys.append(float(r["value"]))
+    return out
 
 
 def plot_convergence(rows, out):
@@ -94,7 +112,13 @@ def plot_test3(rows, out):
     plt.close(fig)
 
 
-def plot_test4(rows, out):
+# Kharaz et al. (2001): 5 mm spheres (R = 2.5 mm) at 3.9 m/s, as test 4.
+TEST4_RADIUS = 0.0025
+TEST4_SPEED = 3.9
+
+
+def plot_test4(rows, out, ref=None):
+    ref = ref or {}
     ang = [float(r["angle_deg"]) for r in rows]
     slide = [r for r in rows]
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.8))
@@ -110,18 +134,27 @@ def plot_test4(rows, out):
                 label="engine, 8x finer dt")
         ax.plot(ang, [float(r[key]) for r in rows], "o", color="tab:blue", mfc="none", ms=6,
                 label=f"engine ({float(rows[0]['steps_per_contact']):.0f} steps/contact)")
+        if key == "vt_ratio" and "vt_ratio" in ref:
+            ax.plot(*ref["vt_ratio"], "D", color="k", ms=5, label="measured, Kharaz et al. 2001")
+        if key == "omega_r_over_v" and "omega" in ref:
+            xs, ys = ref["omega"]
+            ax.plot(xs, [w * TEST4_RADIUS / TEST4_SPEED for w in ys], "D", color="k", ms=5,
+                    label="measured, Kharaz et al. 2001")
         ax.set_xlabel("incidence angle from the normal [deg]")
         ax.set_ylabel(ylabel)
         ax.grid(True, alpha=0.3)
     axes[0].set_ylim(-0.2, 1.05)
     axes[1].set_ylim(0, 0.5)
     axes[0].legend(fontsize=8, loc="lower right")
+    axes[1].legend(fontsize=8, loc="upper right")
     ax = axes[2]
     ax.plot([0, 90], [0, 90], "k-", lw=0.6, alpha=0.4, label="rebound = incidence")
     ax.plot(ang, [float(r["rebound_deg_rigid"]) for r in rows], "k-", lw=1.0, alpha=0.6,
             label="centre, rigid-body theory")
     ax.plot(ang, [float(r["rebound_deg"]) for r in rows], "o", color="tab:blue", mfc="none", ms=6,
             label="centre, engine")
+    if "rebound_deg" in ref:
+        ax.plot(*ref["rebound_deg"], "D", color="k", ms=5, label="centre, measured (Kharaz et al. 2001)")
     ax.plot(ang, [float(r["patch_rebound_deg_rigid"]) for r in rows], "k--", lw=1.0, alpha=0.6,
             label="contact patch, rigid-body theory")
     ax.plot(ang, [float(r["patch_rebound_deg"]) for r in rows], "s", color="tab:red", mfc="none", ms=5,
@@ -136,22 +169,24 @@ def plot_test4(rows, out):
             a.axvspan(min(onset), 90, color="g", alpha=0.05)
         a.set_xlim(0, 90)
     fig.suptitle("Chung & Ooi test 4: aluminium oxide sphere on a rigid plane, 3.9 m/s, mu = 0.092, e = 0.98 "
-                 "(shaded: gross sliding in rigid-body theory)", fontsize=11)
-    fig.tight_layout(rect=(0, 0, 1, 0.94))
+                 "(shaded: gross sliding in rigid-body theory)\ndiamonds: measurements of Kharaz, Gorham & Salman (2001), the experiment the test reproduces",
+                 fontsize=10)
+    fig.tight_layout(rect=(0, 0, 1, 0.91))
     fig.savefig(out, dpi=110)
     plt.close(fig)
 
 
 def main(argv):
-    if len(argv) != 3:
+    if len(argv) not in (3, 4):
         sys.stderr.write(__doc__)
         return 2
     src, dst = argv[1], argv[2]
+    ref = read_reference(argv[3] if len(argv) == 4 else DEFAULT_REFERENCE)
     os.makedirs(dst, exist_ok=True)
     plot_convergence(read_csv(os.path.join(src, "restitution_convergence.csv")),
                      os.path.join(dst, "restitution_convergence.png"))
     plot_test3(read_csv(os.path.join(src, "chung_ooi_test3.csv")), os.path.join(dst, "chung_ooi_test3.png"))
-    plot_test4(read_csv(os.path.join(src, "chung_ooi_test4.csv")), os.path.join(dst, "chung_ooi_test4.png"))
+    plot_test4(read_csv(os.path.join(src, "chung_ooi_test4.csv")), os.path.join(dst, "chung_ooi_test4.png"), ref)
     for name in ("restitution_convergence.png", "chung_ooi_test3.png", "chung_ooi_test4.png"):
         print(os.path.join(dst, name))
     return 0

@@ -165,6 +165,7 @@ RunReport run_scenario(Scenario& sc, State& s, const RunOptions& opt) {
       }
       const double t_stage1 = s.time + st.duration;
       double next_check = s.time + st.check_every;
+      double next_quench = s.time + st.quench_every;
       StageReport sr{st.name, 0, "duration", removed};
       while (s.time < t_stage1 - 0.5 * m.dt) {
         if (st.set_gravity && st.gravity_ramp > 0) {
@@ -183,6 +184,13 @@ RunReport run_scenario(Scenario& sc, State& s, const RunOptions& opt) {
           next_sample += sc.output_every;
         }
         step(m, s);
+        if (st.quench_every > 0 && s.time >= next_quench - 0.5 * m.dt) {
+          next_quench += st.quench_every;
+          for (int i = 0; i < m.n_grains; ++i) {
+            s.vel[i].setZero();
+            s.omega[i].setZero();
+          }
+        }
         rep.max_overlap_ratio = std::max(rep.max_overlap_ratio, s.stats.max_overlap_ratio);
         for (size_t h = 0; h < held_ids.size(); ++h) {  // held grains stay put
           s.pos[held_ids[h]] = held_pos[h];

@@ -37,6 +37,8 @@ struct Stage {
   double gravity_ramp = 0;            // s over which gravity moves geometrically to the new value (0: at once)
   double stiffness_scale = 0;         // > 0: k_n of this stage = scale * the scene's, dt = scene dt / sqrt(scale)
                                       //      (softer springs for bed preparation); 0: keep the current values
+  double quench_every = 0;            // > 0: every this many seconds, all grain velocities and spins are
+                                      //      set to zero (bed preparation: a quasi-static descent)
   bool trim = false;                  // remove grains at the start of the stage
   double trim_above = 0;              // ... whose centre lies above this height (z), m
 };

@@ -1,5 +1,6 @@
 // Stage runner with observers and progress output.
 #include "regolith_twin/observe/runner.hpp"
+#include "regolith_twin/scene/snapshot.hpp"
 
 #include <sys/stat.h>
 
@@ -224,6 +225,7 @@ RunReport run_scenario(Scenario& sc, State& s, const RunOptions& opt) {
       }
       sr.t_end = s.time;
       rep.stages.push_back(sr);
+      if (write && opt.stage_snapshots) write_snapshot(opt.out_dir + "/" + st.name + ".bed", m, s);
     }
     if (write) sample();
   } catch (const BlowUpError& e) {

@@ -24,6 +24,7 @@ void usage(std::FILE* f) {
                "  --set k=v       override a scenario key, e.g. --set contact.steps_per_contact=60\n"
                "  --snapshot F    also write the final grains as a compact bed snapshot F (float32)\n"
                "  --checkpoint F  also write the exact final state (with contact history) to F\n"
+               "  --stage-snapshots  also write DIR/<stage>.bed after every stage (restart points)\n"
                "  --quiet         no progress lines\n");
 }
 
@@ -33,7 +34,7 @@ int main(int argc, char** argv) {
   std::string file, out, snapshot, checkpoint;
   std::vector<std::string> overrides;
   int threads = 0;
-  bool quiet = false;
+  bool quiet = false, stage_snapshots = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&](const char* name) -> std::string {
@@ -59,6 +60,8 @@ int main(int argc, char** argv) {
       snapshot = value("--snapshot");
     } else if (a == "--checkpoint") {
       checkpoint = value("--checkpoint");
+    } else if (a == "--stage-snapshots") {
+      stage_snapshots = true;
     } else if (a == "--quiet") {
       quiet = true;
     } else if (a == "-h" || a == "--help") {
@@ -99,6 +102,7 @@ int main(int argc, char** argv) {
     opt.out_dir = out;
     opt.progress_every = quiet ? 0 : 2.0;
     opt.threads = threads;
+    opt.stage_snapshots = stage_snapshots;
     rt::State s = sc.initial;
     const rt::RunReport rep = rt::run_scenario(sc, s, opt);
     if (rep.status != "ok") {

@@ -15,6 +15,7 @@ struct RunOptions {
   std::string out_dir;          // created if missing; empty: write nothing
   double progress_every = 2.0;  // wall seconds between progress lines (<= 0: none)
   int threads = 0;              // recorded in the summary (set by the caller)
+  bool stage_snapshots = false; // write out_dir/<stage>.bed (compact snapshot) after every stage
 };
 
 struct StageReport {

@@ -94,7 +94,8 @@ LandingSpec parse_landing(const YAML::Node& n, const std::string& src) {
   const std::vector<std::string> keys = {"lander", "rim", "container_radius", "attitude", "pitch_deg", "roll_deg",
                                          "angle_deg", "heading_deg", "speed", "clearance", "aim", "slope_deg", "g",
                                          "after_liftoff", "max_after_contact", "max_time", "far_ring",
-                                         "sphere_radius", "repeat", "perturb_seed", "sample_every"};
+                                         "sphere_radius", "repeat", "perturb_seed", "sample_every",
+                                         "active_radius"};
   BlockReader rd{n, src};
   for (const auto& kv : n) {
     const std::string k = kv.first.as<std::string>();
@@ -135,6 +136,7 @@ LandingSpec parse_landing(const YAML::Node& n, const std::string& src) {
   sp.repeat = long(rd.num("repeat", 0, 0, 1e6));
   sp.perturb_seed = (unsigned long)rd.num("perturb_seed", 1, 0, 4e9);
   sp.sample_every = rd.num("sample_every", sp.sample_every, 1e-6, 1e3);
+  sp.active_radius = rd.num("active_radius", sp.active_radius, 0, 1e3);
   return sp;
 }
 
@@ -241,7 +243,59 @@ void write_surface(const std::string& path, const Model& m, const State& s, cons
     }
 }
 
-LandingOutcome run_landing(const Model& m, State& s, int b, const LandingSpec& sp, const LandingOptions& opt) {
+namespace {
+
+// Active zone: freeze grains (infinite mass, at rest) beyond the radius from
+// the lander's vertical axis, wake those it reaches; woken grains stay free.
+class ActiveZone {
+ public:
+  ActiveZone(Model& m, double radius) : m_(m), radius_(radius) {
+    inv_mass_ = m.grain_inv_mass;
+    inv_inertia_ = m.grain_inv_inertia;
+    fixed0_ = m.grain_fixed;
+    woken_.assign(m.n_grains, 0);
+  }
+  // Update around horizontal position c; returns true when grains changed state.
+  bool update(State& s, const Vec3& c, bool first) {
+    if (radius_ <= 0) return false;
+    if (!first && std::hypot(c.x() - last_.x(), c.y() - last_.y()) < 0.02) return false;
+    last_ = c;
+    bool changed = false;
+    for (int i = 0; i < m_.n_grains; ++i) {
+      if (fixed0_[i] || woken_[i]) continue;
+      const bool inside = std::hypot(s.pos[i].x() - c.x(), s.pos[i].y() - c.y()) < radius_;
+      if (inside) {
+        woken_[i] = 1;
+        m_.grain_fixed[i] = 0;
+        m_.grain_inv_mass[i] = inv_mass_[i];
+        m_.grain_inv_inertia[i] = inv_inertia_[i];
+        changed = changed || !first;
+      } else if (first) {
+        m_.grain_fixed[i] = 1;
+        m_.grain_inv_mass[i] = 0;
+        m_.grain_inv_inertia[i] = 0;
+        s.vel[i].setZero();
+        s.omega[i].setZero();
+        changed = true;
+      }
+    }
+    if (changed) s.rebuild_requested = true;  // pair constants (m*) and partitions follow
+    return changed;
+  }
+  double radius() const { return radius_; }
+  const Vec3& centre() const { return last_; }
+
+ private:
+  Model& m_;
+  double radius_;
+  std::vector<double> inv_mass_, inv_inertia_;
+  std::vector<uint8_t> fixed0_, woken_;
+  Vec3 last_ = Vec3::Zero();
+};
+
+}  // namespace
+
+LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& sp, const LandingOptions& opt) {
   using Clock = std::chrono::steady_clock;
   LandingOutcome o;
   const BodyModel& bm = m.bodies[b];
@@ -260,7 +314,9 @@ LandingOutcome run_landing(const Model& m, State& s, int b, const LandingSpec& s
   mean_r = m.n_grains ? mean_r / m.n_grains : 0;
   std::vector<uint8_t> ejected(m.n_grains, 0), above0(m.n_grains, 0);
   for (int i = 0; i < m.n_grains; ++i) above0[i] = s.pos[i].z() > sp.rim + mean_r;  // not counted
-  if (!s.forces_valid) prime(m, s);
+  ActiveZone zone(m, sp.active_radius);
+  zone.update(s, s.bodies[b].pos, true);
+  if (!s.forces_valid || s.rebuild_requested) prime(m, s);
   const int check_every = std::max(1, int(std::lround(1e-3 / m.dt)));  // ejecta sampled each millisecond
   double next_sample = s.time;
   bool below_once = false;
@@ -327,6 +383,7 @@ LandingOutcome run_landing(const Model& m, State& s, int b, const LandingSpec& s
           }
         }
       }
+      if (s.step % check_every == 0) zone.update(s, bs.pos, false);
       if (s.step % check_every == 0)
         for (int i = 0; i < m.n_grains; ++i)
           if (!ejected[i] && !above0[i] && s.pos[i].z() > sp.rim + mean_r) {
@@ -387,6 +444,17 @@ LandingOutcome run_landing(const Model& m, State& s, int b, const LandingSpec& s
       ++cnt;
     }
   o.far_field_rms = cnt ? std::sqrt(sum / cnt) : 0;
+  sum = 0;
+  cnt = 0;
+  for (int i = 0; i < m.n_grains; ++i) {
+    o.active_grains += m.grain_inv_mass[i] != 0;
+    const double d = std::hypot(s.pos[i].x() - zone.centre().x(), s.pos[i].y() - zone.centre().y());
+    if (zone.radius() > 0 && m.grain_inv_mass[i] != 0 && d > zone.radius() - sp.far_ring) {
+      sum += s.vel[i].squaredNorm();
+      ++cnt;
+    }
+  }
+  o.active_edge_rms = cnt ? std::sqrt(sum / cnt) : 0;
   o.steps = s.step - step0;
   o.wall_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   if (write && o.status == "ok")

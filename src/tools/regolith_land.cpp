@@ -230,6 +230,8 @@ int main(int argc, char** argv) {
     oc.num("second_impact_speed", o.second_impact_speed).num("second_impact_angle_deg", o.second_impact_angle_deg);
     oc.num("ejected_volume", o.ejected_volume).num("ejected_grains", double(o.ejected_grains));
     oc.num("far_field_rms_speed", o.far_field_rms).num("max_overlap_ratio", o.max_overlap_ratio);
+    oc.num("active_radius", spec.active_radius).num("active_grains", double(o.active_grains));
+    oc.num("active_edge_rms_speed", o.active_edge_rms);
     j.obj("outcome", oc);
     rt::JsonObject run;
     run.num("steps", double(o.steps)).num("wall_seconds", o.wall_seconds).num("dt", m.dt).num("kn", m.kn);

@@ -38,6 +38,12 @@ struct LandingSpec {
   long repeat = 0;               // perturbed bed number (0: the bed as prepared)
   unsigned long perturb_seed = 1;  // seed of the perturbation of repeat > 0
   double sample_every = 0.01;    // s between time-series rows
+  // Active zone: grains farther than this (horizontally) from the lander stay
+  // frozen where the relaxed bed left them; the zone follows the lander and
+  // a grain once woken stays free. 0: every grain is free. The RMS speed in
+  // the zone's outer ring is reported, so a run shows whether the frozen bed
+  // beyond it was indeed at rest.
+  double active_radius = 0;
 };
 
 // Read a `landing:` block (every error names the file and the key).
@@ -87,6 +93,8 @@ struct LandingOutcome {
   double ejected_volume = 0;     // volume of grains whose centre ever rose > one mean radius above the plane, m^3
   long ejected_grains = 0;
   double far_field_rms = 0;      // RMS grain speed in the outer ring at the end, m/s
+  double active_edge_rms = 0;    // RMS speed of free grains in the outer far_ring of the active zone at the end, m/s
+  long active_grains = 0;        // grains free at the end (all grains without an active zone)
   double max_overlap_ratio = 0;
   long steps = 0;
   double wall_seconds = 0;
@@ -100,7 +108,8 @@ struct LandingOptions {
 };
 
 // Run the landing from the placed state to the run end, observing the outcome.
-LandingOutcome run_landing(const Model& m, State& s, int b, const LandingSpec& spec, const LandingOptions& opt);
+// The model is changed only by the active zone (grains frozen and woken).
+LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& spec, const LandingOptions& opt);
 
 // Height map of the bed surface (top of the highest grain per cell) over the
 // container, written as CSV rows "x,y,height above the trim plane".

@@ -319,7 +319,6 @@ LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& sp, con
   if (!s.forces_valid || s.rebuild_requested) prime(m, s);
   const int check_every = std::max(1, int(std::lround(1e-3 / m.dt)));  // ejecta sampled each millisecond
   double next_sample = s.time;
-  bool below_once = false;
   const BodyState& bs = s.bodies[b];
   auto lowest_corner = [&] {
     double low = 1e300;
@@ -347,13 +346,17 @@ LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& sp, con
         o.e_lin_in = body_lin_energy(bm, bs);
         o.e_rot_in = body_rot_energy(bm, bs);
       }
+      if (o.lifted_off && touching) {
+        // Contact again within the after-lift-off window: the lander had not
+        // left; the collision goes on (decision, documented in landing.hpp).
+        o.lifted_off = false;
+        ++o.relandings;
+      }
       if (o.contact && !o.lifted_off) {
         o.max_penetration = std::max(o.max_penetration, -low);
-        below_once = below_once || low < 0;
-        // Lift-off: every corner above the trim plane, after one had been
-        // below it; a lander that never went below the plane lifts off when
-        // it no longer touches and moves away from the surface (decision).
-        const bool up = low > 0 && (below_once ? true : (!touching && bs.vel.z() > 0));
+        // Lift-off: every corner above the trim plane, no contact, and the
+        // centre of mass moving away from the surface.
+        const bool up = low > 0 && !touching && bs.vel.z() > 0;
         if (up) {
           o.lifted_off = true;
           o.t_liftoff = s.time;

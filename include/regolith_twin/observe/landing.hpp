@@ -74,7 +74,12 @@ std::vector<Vec3> lander_corners(const Model& m, const State& s, int b);
 
 struct LandingOutcome {
   bool contact = false;          // the lander touched the bed
-  bool lifted_off = false;       // all eight corners went back above the trim plane
+  // Lift-off: all eight corners above the trim plane, no contact left and the
+  // centre of mass moving away from the surface. A contact within the
+  // after_liftoff window cancels it (the lander had not left: corners of a
+  // tilted lander can all be above the plane in mid-collision while it turns).
+  bool lifted_off = false;
+  int relandings = 0;            // lift-offs cancelled by a renewed contact
   std::string ended_by;          // after_liftoff | max_after_contact | max_time
   double t_contact = 0, t_liftoff = 0, t_end = 0;  // s
   double v_in = 0, v_out = 0;    // centre-of-mass speed at first contact and at lift-off, m/s

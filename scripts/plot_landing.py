@@ -178,9 +178,11 @@ def plot_surface(run, surf, s, summary, head):
     fig, ax = plt.subplots(figsize=(7.2, 6))
     # Colour range: the bulk of the surface, so that a crater or a few ejected
     # grains high above do not wash out the map.
-    lo, hi = np.nanpercentile(grid, [0.5, 99.5])
+    lo, hi = np.nanpercentile(grid, [1, 99])
     lim = max(abs(lo), abs(hi), 1e-4)
-    im = ax.imshow(100 * grid, origin="lower", extent=extent, cmap="RdBu_r", vmin=-100 * lim, vmax=100 * lim,
+    cmap = plt.get_cmap("RdBu_r").copy()
+    cmap.set_bad("0.8")  # cells without a grain centre
+    im = ax.imshow(100 * grid, origin="lower", extent=extent, cmap=cmap, vmin=-100 * lim, vmax=100 * lim,
                    interpolation="nearest")
     cb = fig.colorbar(im, ax=ax)
     cb.set_label("surface height above the trim plane (cm)")
@@ -191,7 +193,7 @@ def plot_surface(run, surf, s, summary, head):
     if oc.get("contact") and s is not None:
         i = int(np.searchsorted(s["t"], oc.get("t_contact", 0.0)))
         i = min(i, len(s["t"]) - 1)
-        ax.plot(s["x"][i], s["y"][i], "x", color="tab:red", ms=8, label="first contact")
+        ax.plot(s["x"][i], s["y"][i], "x", color="tab:red", ms=8, label="centre of mass at first contact")
     rc = summary.get("bed", {}).get("container_radius")
     if rc is None:
         rc = max(abs(extent[0]), abs(extent[1]))

@@ -92,8 +92,10 @@ def read_json(path):
 
 
 def is_done(run_dir):
+    """A finished run: summary.json with status ok, from a regolith_land that exited 0."""
     s = read_json(os.path.join(run_dir, "summary.json"))
-    return bool(s) and s.get("status") == "ok"
+    meta = read_json(os.path.join(run_dir, "sweep_run.json"))
+    return bool(s) and s.get("status") == "ok" and bool(meta) and meta.get("exit_code") == 0
 
 
 def fmt_time(sec):
@@ -110,6 +112,15 @@ def fmt_time(sec):
 class Child:
     """The regolith_land process under way, stopped with the sweep."""
     proc = None
+
+
+def die_with_parent():
+    """In the child: be stopped when the sweep process dies, even by SIGKILL (Linux)."""
+    try:
+        import ctypes
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+    except Exception:
+        pass
 
 
 def on_signal(signum, _frame):
@@ -149,7 +160,7 @@ def run_one(a, land, point, bed, out_runs, index, total, eta_text):
     print(f"[{index}/{total}] start {name}  ({time.strftime('%H:%M:%S')}; ETA {eta_text})", flush=True)
     t0 = time.time()
     with open(os.path.join(tmp, "run.log"), "w") as log:
-        Child.proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT)
+        Child.proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, preexec_fn=die_with_parent)
         try:
             rc = Child.proc.wait()
         finally:
@@ -170,19 +181,13 @@ def run_one(a, land, point, bed, out_runs, index, total, eta_text):
     meta["status"] = status
     with open(os.path.join(tmp, "sweep_run.json"), "w") as f:
         json.dump(meta, f, indent=1)
-    if status == "ok" and not a.no_run_plots:
-        try:
-            import plot_landing
-            plot_landing.main([tmp])
-            import matplotlib.pyplot as plt
-            plt.close("all")
-        except Exception as e:  # a plot problem does not lose the run
-            print(f"sweep: warning: plots of {name}: {e}", file=sys.stderr)
     # Failed runs are kept for inspection under the same name; their summary
     # has no status ok, so the next sweep redoes them.
     if os.path.exists(final):
         shutil.rmtree(final)
     os.rename(tmp, final)
+    if status == "ok" and not a.no_run_plots:
+        plot_run(final)
     return rc, status, wall, summary
 
 
@@ -201,6 +206,10 @@ def sweep(a, grid, land):
                 fail(f"{d} was made with other settings:\n  {meta.get('config')} --set "
                      + " --set ".join(meta.get("overrides", [])) + f"\nnow:\n  {a.config} --set "
                      + " --set ".join(want) + "\nuse another --out, or remove that run folder to redo it")
+    # The grid of this command, for the report.
+    with open(os.path.join(a.out, "sweep.json"), "w") as f:
+        json.dump(dict(a.grid_lists, config=a.config, bed_dir=a.bed_dir, set=a.set, threads=a.threads,
+                       started=time.strftime("%Y-%m-%d %H:%M:%S")), f, indent=1)
     done_before = total - len(todo)
     print(f"sweep: {total} runs in {a.out}/runs ({done_before} already done, {len(todo)} to run)", flush=True)
     walls, failed = [], []
@@ -276,7 +285,8 @@ def write_aggregate(out, rows, outcome_keys):
         w = csv.writer(f)
         w.writerow(cols)
         for r in rows:
-            w.writerow(["" if r.get(c) is None else r.get(c) for c in cols])
+            w.writerow(["" if r.get(c) is None else fmt_num(r[c]) if c in ("depth", "angle") else r.get(c)
+                        for c in cols])
     return path
 
 
@@ -444,10 +454,34 @@ def write_report(out, rows, outcome_keys, plots, spread, grid_meta):
     return path
 
 
+def plot_run(run_dir):
+    """The plots of plot_landing.py for one run; a plot problem does not lose the run."""
+    import contextlib
+    try:
+        import matplotlib.pyplot as plt
+        import plot_landing
+        with contextlib.redirect_stdout(open(os.devnull, "w")):
+            plot_landing.main([run_dir])
+        plt.close("all")
+    except Exception as e:
+        print(f"sweep: warning: plots of {run_dir}: {e}", file=sys.stderr)
+
+
+def run_plots(a, rows):
+    """Per-run plots of finished runs that have none yet (e.g. runs made without matplotlib)."""
+    if a.no_run_plots:
+        return
+    for r in rows:
+        d = os.path.join(a.out, "runs", r["run"])
+        if r["status"] == "ok" and not os.path.exists(os.path.join(d, "surface.png")):
+            plot_run(d)
+
+
 def report(a):
     rows, outcome_keys = collect(a.out)
     if not rows:
         fail(f"no runs in {a.out}/runs")
+    run_plots(a, rows)
     grid_meta = read_json(os.path.join(a.out, "sweep.json"))
     agg = write_aggregate(a.out, rows, outcome_keys)
     plots = plot_metrics(a.out, rows, a.spread)
@@ -519,6 +553,8 @@ def main(argv=None):
         fail(f"regolith_land not found at {land} (build first: scripts/sweep builds it)")
     sim = a.sim or os.path.join(os.path.dirname(land), "regolith_sim")
 
+    a.grid_lists = {"materials": mats, "depths": depths, "attitudes": atts, "angles": angles,
+                    "repeats": list(range(a.repeats))}
     grid = [(m, d, t, ang, r) for m in mats for d in depths for t in atts for ang in angles
             for r in range(a.repeats)]
     if a.dry_run:
@@ -541,11 +577,6 @@ def main(argv=None):
     if a.dry_run:
         return 0
 
-    os.makedirs(a.out, exist_ok=True)
-    with open(os.path.join(a.out, "sweep.json"), "w") as f:
-        json.dump({"materials": mats, "depths": depths, "attitudes": atts, "angles": angles,
-                   "repeats": list(range(a.repeats)), "config": a.config, "bed_dir": a.bed_dir, "set": a.set,
-                   "threads": a.threads, "started": time.strftime("%Y-%m-%d %H:%M:%S")}, f, indent=1)
     signal.signal(signal.SIGTERM, on_signal)
     t0 = time.time()
     try:

@@ -493,6 +493,7 @@ def report(a):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(
+        prog="scripts/sweep",
         description="MASCOT landing sweep: materials x depths x attitudes x angles x repeats of regolith_land.",
         epilog="example: scripts/sweep --materials moderate,gravel --depths 0.30 --attitudes BCF "
                "--angles 0,30,60 --repeats 3 --out out/sweep1")

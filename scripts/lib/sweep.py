@@ -1,0 +1,595 @@
+#!/usr/bin/env python3
+"""MASCOT landing campaign (SCENARIOS.md A): a grid of regolith_land runs.
+
+Normally started through scripts/sweep (which builds first). Every grid point
+materials x depths x attitudes x angles x repeats is one regolith_land run in
+OUT/runs/<material>_d<cm>_<attitude>_a<angle>_r<repeat>/. A run is written in
+a temporary folder that is renamed when the run has finished, so a sweep that
+was stopped is re-run with the same command and continues: finished runs
+(summary.json with status ok) are skipped, unfinished or failed ones redone.
+Afterwards (or with --report-only) OUT/aggregate.csv, OUT/*.png and
+OUT/report.md are written from every run in OUT/runs.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import shlex
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+
+# Outcome numbers of summary.json that the plots show, with axis labels.
+PLOTTED = [
+    ("speed_ratio", "speed ratio V_out / V_in", 1.0),
+    ("travel_distance", "travel distance (m)", 1.0),
+    ("max_penetration", "maximum penetration (cm)", 100.0),
+    ("collision_duration", "collision duration (s)", 1.0),
+]
+KEYS = ["material", "depth", "attitude", "angle", "repeat"]
+
+
+def fail(msg, code=2):
+    print(f"sweep: {msg}", file=sys.stderr)
+    sys.exit(code)
+
+
+def split_list(text, kind, name):
+    items = [x.strip() for x in text.split(",") if x.strip()]
+    if not items:
+        fail(f"--{name}: empty list")
+    try:
+        return [kind(x) for x in items]
+    except ValueError:
+        fail(f"--{name} '{text}': expected a comma-separated list of {kind.__name__}")
+
+
+def depth_cm(d):
+    return int(round(d * 100))
+
+
+def fmt_num(x):
+    """Short text of a number for folder names: 30 -> '30', 22.5 -> '22.5'."""
+    return f"{x:g}"
+
+
+def run_name(mat, depth, att, angle, rep):
+    return f"{mat}_d{depth_cm(depth)}_{att}_a{fmt_num(angle)}_r{rep}"
+
+
+def bed_file(bed_dir, mat, depth):
+    return os.path.join(bed_dir, f"mascot_{mat}_d{depth_cm(depth)}.bed")
+
+
+def fill_count(depth):
+    """Grains to generate for a bed trimmed at `depth` (80000 for the 0.30 m default)."""
+    return 1000 * math.ceil(80 * (depth + 0.05) / 0.35)
+
+
+def bed_command(sim, mat, depth, path):
+    args = [sim, os.path.join(ROOT, "config", "beds", "mascot_bed.yaml"),
+            "--set", f"materials.regolith.preset={mat}", "--set", f"materials.container.preset={mat}",
+            "--set", f"stages.1.trim_above={depth:g}"]
+    if depth_cm(depth) != 30:
+        args += ["--set", f"grains.0.fill.count={fill_count(depth)}"]
+    args += ["--out", os.path.join(ROOT, "out", f"bed_{mat}_d{depth_cm(depth)}"), "--snapshot", path]
+    return " ".join(shlex.quote(a) for a in args)
+
+
+def read_json(path):
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None
+
+
+def is_done(run_dir):
+    """A finished run: summary.json with status ok, from a regolith_land that exited 0."""
+    s = read_json(os.path.join(run_dir, "summary.json"))
+    meta = read_json(os.path.join(run_dir, "sweep_run.json"))
+    return bool(s) and s.get("status") == "ok" and bool(meta) and meta.get("exit_code") == 0
+
+
+def fmt_time(sec):
+    sec = max(0, int(round(sec)))
+    if sec < 120:
+        return f"{sec} s"
+    if sec < 7200:
+        return f"{sec / 60:.1f} min"
+    return f"{sec / 3600:.1f} h"
+
+
+# ---------------------------------------------------------------- running
+
+class Child:
+    """The regolith_land process under way, stopped with the sweep."""
+    proc = None
+
+
+def die_with_parent():
+    """In the child: be stopped when the sweep process dies, even by SIGKILL (Linux)."""
+    try:
+        import ctypes
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+    except Exception:
+        pass
+
+
+def on_signal(signum, _frame):
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
+def run_overrides(a, point, bed):
+    """The --set options of one run: the grid point, then the sweep's own --set."""
+    mat, depth, att, angle, rep = point
+    ov = [f"materials.regolith.preset={mat}"]
+    # The container and the lander take the friction of the grains (SCENARIOS.md A).
+    if not a.regolith_only:
+        ov += [f"materials.container.preset={mat}", f"materials.lander.preset={mat}"]
+    ov += [f"landing.rim={depth:g}", f"grains.0.file={bed}", f"landing.attitude={att}",
+           f"landing.angle_deg={angle:g}", f"landing.repeat={rep}"]
+    return ov + list(a.set)
+
+
+def run_one(a, land, point, bed, out_runs, index, total, eta_text):
+    mat, depth, att, angle, rep = point
+    name = run_name(*point)
+    final = os.path.join(out_runs, name)
+    tmp = os.path.join(out_runs, f".{name}.tmp")
+    if os.path.exists(tmp):
+        shutil.rmtree(tmp)
+    os.makedirs(tmp)
+    overrides = run_overrides(a, point, bed)
+    cmd = [land, a.config, "--out", tmp, "--quiet"]
+    for o in overrides:
+        cmd += ["--set", o]
+    if a.threads:
+        cmd += ["--threads", str(a.threads)]
+    if a.cache:
+        cmd += ["--cache", a.cache]
+    meta = {"name": name, "material": mat, "depth": depth, "attitude": att, "angle": angle, "repeat": rep,
+            "config": a.config, "bed": bed, "overrides": overrides, "command": cmd}
+    print(f"[{index}/{total}] start {name}  ({time.strftime('%H:%M:%S')}; ETA {eta_text})", flush=True)
+    t0 = time.time()
+    with open(os.path.join(tmp, "run.log"), "w") as log:
+        Child.proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, preexec_fn=die_with_parent)
+        try:
+            rc = Child.proc.wait()
+        finally:
+            if Child.proc.poll() is None:
+                Child.proc.terminate()
+                try:
+                    Child.proc.wait(timeout=10)
+                except subprocess.TimeoutExpired:
+                    Child.proc.kill()
+            Child.proc = None
+    wall = time.time() - t0
+    meta["exit_code"] = rc
+    meta["wall_seconds"] = round(wall, 3)
+    summary = read_json(os.path.join(tmp, "summary.json")) or {}
+    status = summary.get("status", "missing") if rc == 0 or summary else f"exit {rc}"
+    if rc != 0 and status == "ok":
+        status = f"exit {rc}"
+    meta["status"] = status
+    with open(os.path.join(tmp, "sweep_run.json"), "w") as f:
+        json.dump(meta, f, indent=1)
+    # Failed runs are kept for inspection under the same name; their summary
+    # has no status ok, so the next sweep redoes them.
+    if os.path.exists(final):
+        shutil.rmtree(final)
+    os.rename(tmp, final)
+    if status == "ok" and not a.no_run_plots:
+        plot_run(final)
+    return rc, status, wall, summary
+
+
+def sweep(a, grid, land):
+    out_runs = os.path.join(a.out, "runs")
+    os.makedirs(out_runs, exist_ok=True)
+    total = len(grid)
+    todo = [(i, p) for i, p in enumerate(grid, 1) if not is_done(os.path.join(out_runs, run_name(*p)))]
+    # Finished runs are only reused when they were made with the same settings.
+    for p in grid:
+        d = os.path.join(out_runs, run_name(*p))
+        meta = read_json(os.path.join(d, "sweep_run.json"))
+        if is_done(d) and meta is not None:
+            want = run_overrides(a, p, bed_file(a.bed_dir, p[0], p[1]))
+            if meta.get("config") != a.config or meta.get("overrides") != want:
+                fail(f"{d} was made with other settings:\n  {meta.get('config')} --set "
+                     + " --set ".join(meta.get("overrides", [])) + f"\nnow:\n  {a.config} --set "
+                     + " --set ".join(want) + "\nuse another --out, or remove that run folder to redo it")
+    # The grid of this command, for the report.
+    with open(os.path.join(a.out, "sweep.json"), "w") as f:
+        json.dump(dict(a.grid_lists, config=a.config, bed_dir=a.bed_dir, set=a.set, threads=a.threads,
+                       started=time.strftime("%Y-%m-%d %H:%M:%S")), f, indent=1)
+    done_before = total - len(todo)
+    print(f"sweep: {total} runs in {a.out}/runs ({done_before} already done, {len(todo)} to run)", flush=True)
+    walls, failed = [], []
+    for k, (i, p) in enumerate(todo):
+        left = len(todo) - k
+        eta_text = fmt_time(sum(walls) / len(walls) * left) if walls else "after the first run"
+        rc, status, wall, summary = run_one(a, land, p, bed_file(a.bed_dir, p[0], p[1]), out_runs, i, total,
+                                            eta_text)
+        walls.append(wall)
+        left -= 1
+        eta = fmt_time(sum(walls) / len(walls) * left) if left else "0 s"
+        name = run_name(*p)
+        if status == "ok":
+            oc = summary.get("outcome", {})
+            what = ("lifted off" if oc.get("lifted_off") else "no lift-off") + \
+                f", speed ratio {oc.get('speed_ratio', 0):.3f}"
+            print(f"[{i}/{total}] done  {name}: {what}; {fmt_time(wall)} wall; ETA {eta}", flush=True)
+        else:
+            failed.append(name)
+            print(f"[{i}/{total}] FAIL  {name}: {status} after {fmt_time(wall)} "
+                  f"(log: {out_runs}/{name}/run.log); ETA {eta}", flush=True)
+            if rc == 2:
+                with open(os.path.join(out_runs, name, "run.log")) as f:
+                    sys.stderr.write(f.read())
+                fail("bad input (exit 2): stopping the sweep")
+    return failed
+
+
+# ---------------------------------------------------------------- report
+
+def collect(out):
+    """One row per run folder in OUT/runs that has sweep_run.json."""
+    rows, outcome_keys = [], []
+    runs = os.path.join(out, "runs")
+    if not os.path.isdir(runs):
+        return rows, outcome_keys
+    for name in sorted(os.listdir(runs)):
+        d = os.path.join(runs, name)
+        if name.startswith(".") or not os.path.isdir(d):
+            continue
+        meta = read_json(os.path.join(d, "sweep_run.json"))
+        if meta is None:
+            continue
+        summary = read_json(os.path.join(d, "summary.json")) or {}
+        oc = summary.get("outcome", {})
+        row = {"run": name}
+        for k in KEYS:
+            row[k] = meta.get(k)
+        row["status"] = summary.get("status", meta.get("status", "missing")) if meta.get("exit_code") == 0 \
+            else meta.get("status", "failed")
+        for k, v in oc.items():
+            if isinstance(v, bool):
+                v = int(v)
+            if isinstance(v, (int, float)):
+                row[k] = v
+                if k not in outcome_keys:
+                    outcome_keys.append(k)
+        bed = summary.get("bed", {})
+        row["grains"] = bed.get("grains")
+        row["packing_fraction"] = bed.get("packing_fraction")
+        row["land_wall_seconds"] = summary.get("run", {}).get("wall_seconds")
+        row["wall_seconds"] = meta.get("wall_seconds")
+        rows.append(row)
+    rows.sort(key=lambda r: (r["material"], r["depth"], r["attitude"], r["angle"], r["repeat"]))
+    return rows, outcome_keys
+
+
+def write_aggregate(out, rows, outcome_keys):
+    cols = ["run"] + KEYS + ["status"] + outcome_keys + ["grains", "packing_fraction", "land_wall_seconds",
+                                                         "wall_seconds"]
+    path = os.path.join(out, "aggregate.csv")
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(cols)
+        for r in rows:
+            w.writerow(["" if r.get(c) is None else fmt_num(r[c]) if c in ("depth", "angle") else r.get(c)
+                        for c in cols])
+    return path
+
+
+def stats(vals):
+    n = len(vals)
+    if n == 0:
+        return None
+    m = sum(vals) / n
+    sd = math.sqrt(sum((v - m) ** 2 for v in vals) / (n - 1)) if n > 1 else 0.0
+    return {"n": n, "mean": m, "sd": sd, "min": min(vals), "max": max(vals)}
+
+
+def groups(rows):
+    """{(material, depth, attitude, angle): [ok rows over repeats]}"""
+    g = {}
+    for r in rows:
+        if r["status"] != "ok":
+            continue
+        g.setdefault((r["material"], r["depth"], r["attitude"], r["angle"]), []).append(r)
+    return g
+
+
+def plot_metrics(out, rows, spread):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    g = groups(rows)
+    if not g:
+        return []
+    mats = sorted({k[0] for k in g})
+    depths = sorted({k[1] for k in g})
+    atts = [x for x in ("Flat", "BCF", "FCF") if x in {k[2] for k in g}] + \
+        sorted({k[2] for k in g} - {"Flat", "BCF", "FCF"})
+    colours = {"Flat": "tab:blue", "BCF": "tab:red", "FCF": "tab:green"}
+    styles = ["-", "--", ":", "-."]
+    markers = ["o", "s", "^", "D"]
+    lines = [(m, t) for m in mats for t in atts]
+    angles = sorted({k[3] for k in g})
+    step = (max(angles) - min(angles)) / max(1, len(angles) - 1) if len(angles) > 1 else 10.0
+    written = []
+    for key, label, scale in PLOTTED:
+        fig, axes = plt.subplots(1, len(depths), figsize=(5.2 * len(depths) + 1.5, 4.2), squeeze=False)
+        for j, d in enumerate(depths):
+            ax = axes[0][j]
+            for li, (m, t) in enumerate(lines):
+                xs, ys, lo, hi = [], [], [], []
+                for ang in angles:
+                    vals = [r[key] * scale for r in g.get((m, d, t, ang), []) if r.get(key) is not None]
+                    s = stats(vals)
+                    if s is None:
+                        continue
+                    # A small sideways shift keeps the error bars of the lines apart.
+                    xs.append(ang + (li - (len(lines) - 1) / 2) * 0.04 * step)
+                    ys.append(s["mean"])
+                    if spread == "minmax":
+                        lo.append(s["mean"] - s["min"])
+                        hi.append(s["max"] - s["mean"])
+                    else:
+                        lo.append(s["sd"])
+                        hi.append(s["sd"])
+                if not xs:
+                    continue
+                ax.errorbar(xs, ys, yerr=[lo, hi], color=colours.get(t, f"C{li}"),
+                            ls=styles[mats.index(m) % len(styles)], marker=markers[mats.index(m) % len(markers)],
+                            ms=4, capsize=3, lw=1.2, label=f"{m}, {t}")
+            ax.set_xlabel("impact angle from the vertical (deg)")
+            ax.set_ylabel(label)
+            ax.set_xticks(angles)
+            ax.set_title(f"bed depth {d:g} m", fontsize=9)
+            ax.grid(alpha=0.3)
+            ax.set_ylim(bottom=min(0, ax.get_ylim()[0]))
+        axes[0][-1].legend(fontsize=8, loc="center left", bbox_to_anchor=(1.02, 0.5))
+        what = "min-max" if spread == "minmax" else "+-1 s.d."
+        fig.suptitle(f"{label}: mean over repeats, bars {what}", fontsize=10)
+        fig.tight_layout()
+        path = os.path.join(out, f"{key}.png")
+        fig.savefig(path, dpi=100)
+        plt.close(fig)
+        written.append(path)
+    return written
+
+
+def fmt(x, digits=3):
+    if x is None:
+        return ""
+    if isinstance(x, float):
+        return f"{x:.{digits}g}"
+    return str(x)
+
+
+def write_report(out, rows, outcome_keys, plots, spread, grid_meta):
+    ok = [r for r in rows if r["status"] == "ok"]
+    bad = [r for r in rows if r["status"] != "ok"]
+    L = ["# MASCOT landing sweep", ""]
+    L.append(f"Folder: `{out}` ({len(rows)} runs: {len(ok)} ok, {len(bad)} failed or unfinished).")
+    if grid_meta:
+        L.append("")
+        L.append("Grid of the last sweep command:")
+        L.append("")
+        for k in ("materials", "depths", "attitudes", "angles", "repeats"):
+            L.append(f"- {k}: {', '.join(fmt_num(x) if isinstance(x, float) else str(x) for x in grid_meta[k])}")
+        L.append(f"- landing file: `{grid_meta['config']}`, beds from `{grid_meta['bed_dir']}`")
+        if grid_meta.get("set"):
+            L.append(f"- overrides: {', '.join('`' + s + '`' for s in grid_meta['set'])}")
+        if grid_meta.get("threads"):
+            L.append(f"- threads per run: {grid_meta['threads']}")
+    L.append("")
+    L.append("Repeat 0 is the bed as prepared; repeats 1, 2, ... are perturbed beds (rotated about the "
+             "container axis, aim point shifted within one grain diameter). A run without lift-off counts "
+             "with V_out = 0 (speed ratio and travel distance 0).")
+    walls = [r["wall_seconds"] for r in ok if r.get("wall_seconds") is not None]
+    if walls:
+        s = stats(walls)
+        L += ["", "## Wall time", "",
+              f"Per run (regolith_land, including loading the bed): mean {fmt_time(s['mean'])}, "
+              f"min {fmt_time(s['min'])}, max {fmt_time(s['max'])}; total {fmt_time(sum(walls))} "
+              f"over {len(walls)} runs."]
+        lw = [r["land_wall_seconds"] for r in ok if r.get("land_wall_seconds") is not None]
+        if lw:
+            L.append(f"Landing phase alone: mean {fmt_time(sum(lw) / len(lw))}.")
+    if plots:
+        L += ["", "## Plots", ""]
+        what = "min-max" if spread == "minmax" else "+-1 s.d."
+        L.append(f"Mean over repeats against the impact angle; bars: {what}.")
+        L.append("")
+        for p in plots:
+            L.append(f"![{os.path.basename(p)}]({os.path.basename(p)})")
+    g = groups(rows)
+    if g:
+        L += ["", "## Ensemble means (over repeats)", "",
+              "mean ± s.d. (n = number of repeats finished); penetration in cm.", "",
+              "| material | depth (m) | attitude | angle (deg) | n | lifted off | speed ratio | travel (m) "
+              "| penetration (cm) | collision (s) |",
+              "|---|---|---|---|---|---|---|---|---|---|"]
+        for k in sorted(g):
+            rs = g[k]
+            cells = []
+            for key, _, scale in PLOTTED:
+                s = stats([r[key] * scale for r in rs if r.get(key) is not None])
+                cells.append(f"{s['mean']:.3g} ± {s['sd']:.2g}" if s else "")
+            lifted = sum(1 for r in rs if r.get("lifted_off"))
+            L.append(f"| {k[0]} | {k[1]:g} | {k[2]} | {fmt_num(k[3])} | {len(rs)} | {lifted}/{len(rs)} | "
+                     + " | ".join(cells) + " |")
+    if rows:
+        L += ["", "## Runs", "", "Every number of the summaries is in `aggregate.csv`; per-run plots are in "
+              "`runs/<run>/*.png`.", "",
+              "| run | status | speed ratio | E_rot,out/E_lin,in | angle out (deg) | travel (m) | penetration (cm) "
+              "| collision (s) | ejected volume (cm³) | wall |",
+              "|---|---|---|---|---|---|---|---|---|---|"]
+        for r in rows:
+            def v(k, scale=1.0):
+                x = r.get(k)
+                return "" if x is None else fmt(x * scale)
+            L.append(f"| {r['run']} | {r['status']} | {v('speed_ratio')} | {v('E_rot_out_over_E_lin_in')} | "
+                     f"{v('angle_out_deg')} | {v('travel_distance')} | {v('max_penetration', 100)} | "
+                     f"{v('collision_duration')} | {v('ejected_volume', 1e6)} | "
+                     f"{fmt_time(r['wall_seconds']) if r.get('wall_seconds') is not None else ''} |")
+    if bad:
+        L += ["", "Failed or unfinished runs (redone by the next sweep with the same command): "
+              + ", ".join(r["run"] for r in bad) + "."]
+    path = os.path.join(out, "report.md")
+    with open(path, "w") as f:
+        f.write("\n".join(L) + "\n")
+    return path
+
+
+def plot_run(run_dir):
+    """The plots of plot_landing.py for one run; a plot problem does not lose the run."""
+    import contextlib
+    try:
+        import matplotlib.pyplot as plt
+        import plot_landing
+        with contextlib.redirect_stdout(open(os.devnull, "w")):
+            plot_landing.main([run_dir])
+        plt.close("all")
+    except Exception as e:
+        print(f"sweep: warning: plots of {run_dir}: {e}", file=sys.stderr)
+
+
+def run_plots(a, rows):
+    """Per-run plots of finished runs that have none yet (e.g. runs made without matplotlib)."""
+    if a.no_run_plots:
+        return
+    for r in rows:
+        d = os.path.join(a.out, "runs", r["run"])
+        if r["status"] == "ok" and not os.path.exists(os.path.join(d, "surface.png")):
+            plot_run(d)
+
+
+def report(a):
+    rows, outcome_keys = collect(a.out)
+    if not rows:
+        fail(f"no runs in {a.out}/runs")
+    run_plots(a, rows)
+    grid_meta = read_json(os.path.join(a.out, "sweep.json"))
+    agg = write_aggregate(a.out, rows, outcome_keys)
+    plots = plot_metrics(a.out, rows, a.spread)
+    rep = write_report(a.out, rows, outcome_keys, plots, a.spread, grid_meta)
+    print(f"aggregate:   {agg}\nplots:       {', '.join(plots) if plots else '(no finished runs)'}\nreport:      {rep}")
+
+
+# ---------------------------------------------------------------- main
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(
+        prog="scripts/sweep",
+        description="MASCOT landing sweep: materials x depths x attitudes x angles x repeats of regolith_land.",
+        epilog="example: scripts/sweep --materials moderate,gravel --depths 0.30 --attitudes BCF "
+               "--angles 0,30,60 --repeats 3 --out out/sweep1")
+    ap.add_argument("--materials", default="moderate", help="comma-separated presets (default moderate)")
+    ap.add_argument("--depths", default="0.30", help="bed depths in m (default 0.30)")
+    ap.add_argument("--attitudes", default="BCF", help="Flat, BCF, FCF (default BCF)")
+    ap.add_argument("--angles", default="30", help="impact angles from the vertical, deg (default 30)")
+    ap.add_argument("--repeats", type=int, default=1,
+                    help="beds per grid point: repeat 0 = as prepared, 1.. perturbed (default 1)")
+    ap.add_argument("--out", required=True, help="output folder")
+    ap.add_argument("--config", default=os.path.join(ROOT, "config", "mascot_landing.yaml"),
+                    help="landing file (default config/mascot_landing.yaml)")
+    ap.add_argument("--bed-dir", default=os.path.join(ROOT, "config", "beds"),
+                    help="folder of the bed snapshots mascot_<material>_d<cm>.bed (default config/beds)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="extra override for every run (after the sweep's own)")
+    ap.add_argument("--threads", type=int, default=0, help="OpenMP threads per run (default: regolith_land's)")
+    ap.add_argument("--cache", default="", help="relaxed-bed cache folder passed to regolith_land")
+    ap.add_argument("--land", default=os.path.join(ROOT, "build", "devel", "lib", "regolith_twin", "regolith_land"),
+                    help="regolith_land binary")
+    ap.add_argument("--sim", default=None, help="regolith_sim binary (named in the bed preparation hint)")
+    ap.add_argument("--spread", choices=["minmax", "sd"], default="minmax",
+                    help="spread over repeats in the plots (default minmax)")
+    ap.add_argument("--regolith-only", action="store_true",
+                    help="set only materials.regolith.preset (container and lander keep the file's presets)")
+    ap.add_argument("--no-run-plots", action="store_true", help="no per-run plots (plot_landing.py)")
+    ap.add_argument("--report-only", action="store_true", help="only write aggregate.csv, plots, report.md")
+    ap.add_argument("--dry-run", action="store_true", help="list the runs and their state, run nothing")
+    a = ap.parse_args(argv)
+    a.out = os.path.abspath(a.out)
+    a.config = os.path.abspath(a.config)
+    a.bed_dir = os.path.abspath(a.bed_dir)
+    if a.report_only:
+        report(a)
+        return 0
+
+    mats = split_list(a.materials, str, "materials")
+    depths = split_list(a.depths, float, "depths")
+    atts = split_list(a.attitudes, str, "attitudes")
+    angles = split_list(a.angles, float, "angles")
+    for t in atts:
+        if t not in ("Flat", "BCF", "FCF"):
+            fail(f"--attitudes: '{t}' is not one of Flat, BCF, FCF")
+    for d in depths:
+        if not 0 < d < 2:
+            fail(f"--depths: {d} m is out of range")
+    if a.repeats < 1:
+        fail("--repeats: at least 1")
+    if a.threads < 0:
+        fail("--threads: at least 1")
+    for s in a.set:
+        if "=" not in s:
+            fail(f"--set '{s}': expected key=value")
+    if not os.path.isfile(a.config):
+        fail(f"landing file {a.config} not found")
+    land = os.path.abspath(a.land)
+    if not a.dry_run and not os.access(land, os.X_OK):
+        fail(f"regolith_land not found at {land} (build first: scripts/sweep builds it)")
+    sim = a.sim or os.path.join(os.path.dirname(land), "regolith_sim")
+
+    a.grid_lists = {"materials": mats, "depths": depths, "attitudes": atts, "angles": angles,
+                    "repeats": list(range(a.repeats))}
+    grid = [(m, d, t, ang, r) for m in mats for d in depths for t in atts for ang in angles
+            for r in range(a.repeats)]
+    if a.dry_run:
+        for i, p in enumerate(grid, 1):
+            d = os.path.join(a.out, "runs", run_name(*p))
+            bed = "" if os.path.isfile(bed_file(a.bed_dir, p[0], p[1])) else " (bed missing)"
+            print(f"[{i}/{len(grid)}] {run_name(*p)}: {'done' if is_done(d) else 'to run'}{bed}")
+    missing = [(m, d) for m in mats for d in depths if not os.path.isfile(bed_file(a.bed_dir, m, d))]
+    if missing:
+        msg = ["bed snapshot(s) missing; prepare each once (hours on 2 cores) with:"]
+        for m, d in missing:
+            path = bed_file(a.bed_dir, m, d)
+            msg.append(f"  {path}:")
+            msg.append(f"    {bed_command(sim, m, d, path)}")
+        msg.append("(config/beds/mascot_bed.yaml; stages.1 is the trim stage, grains.0.fill.count the grains "
+                   "generated: enough that the settled bed reaches the depth)")
+        if not a.dry_run:
+            fail("\n".join(msg))
+        print("\n".join(msg))
+    if a.dry_run:
+        return 0
+
+    signal.signal(signal.SIGTERM, on_signal)
+    t0 = time.time()
+    try:
+        failed = sweep(a, grid, land)
+    except KeyboardInterrupt:
+        print("sweep: stopped; the same command continues where it stopped", file=sys.stderr)
+        return 130
+    print(f"sweep: finished in {fmt_time(time.time() - t0)}"
+          + (f"; {len(failed)} failed: {', '.join(failed)}" if failed else ""), flush=True)
+    report(a)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,107 @@
+#!/usr/bin/env python3
+"""Self-test of scripts/lib/sweep.py and scripts/plot_landing.py with a stand-in
+for regolith_land (test/sweep/fake_land.py): no bed and no build needed.
+
+  /usr/bin/python3 test/sweep/test_sweep.py
+"""
+import csv
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+SWEEP = os.path.join(ROOT, "scripts", "lib", "sweep.py")
+FAKE = os.path.join(HERE, "fake_land.py")
+
+
+class SweepTest(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="sweep_test_")
+        self.beds = os.path.join(self.dir, "beds")
+        os.makedirs(self.beds)
+        for m in ("moderate", "gravel"):
+            open(os.path.join(self.beds, f"mascot_{m}_d30.bed"), "w").close()
+        self.out = os.path.join(self.dir, "out")
+
+    def tearDown(self):
+        if os.environ.get("SWEEP_TEST_KEEP"):
+            print(f"kept {self.dir}")
+        else:
+            shutil.rmtree(self.dir)
+
+    def sweep(self, *extra, env=None):
+        cmd = [sys.executable, SWEEP, "--land", FAKE, "--bed-dir", self.beds, "--out", self.out,
+               "--materials", "moderate,gravel", "--attitudes", "BCF,Flat", "--angles", "0,30,60",
+               "--repeats", "2", *extra]
+        e = dict(os.environ, **(env or {}))
+        return subprocess.run(cmd, capture_output=True, text=True, env=e)
+
+    def rows(self):
+        with open(os.path.join(self.out, "aggregate.csv")) as f:
+            return list(csv.DictReader(f))
+
+    def test_grid_failure_resume_report(self):
+        # One run blows up: the others finish, the sweep reports it and exits 1.
+        p = self.sweep(env={"FAKE_LAND_FAIL": "gravel_d30_Flat_a30_r1"})
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        self.assertIn("FAIL  gravel_d30_Flat_a30_r1", p.stdout)
+        rows = self.rows()
+        self.assertEqual(len(rows), 24)
+        self.assertEqual(sum(r["status"] != "ok" for r in rows), 1)
+        for key in ("speed_ratio", "travel_distance", "max_penetration", "collision_duration"):
+            self.assertTrue(os.path.exists(os.path.join(self.out, key + ".png")))
+        run = os.path.join(self.out, "runs", "moderate_d30_BCF_a30_r0")
+        for png in ("trajectory", "energy", "force", "surface"):
+            self.assertTrue(os.path.exists(os.path.join(run, png + ".png")), png)
+        # A half-finished run (temporary folder) and the failed run are redone, nothing else.
+        os.makedirs(os.path.join(self.out, "runs", ".moderate_d30_BCF_a0_r0.tmp"))
+        shutil.rmtree(os.path.join(self.out, "runs", "moderate_d30_BCF_a0_r0"))
+        p = self.sweep()
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        self.assertIn("22 already done, 2 to run", p.stdout)
+        self.assertFalse(os.path.exists(os.path.join(self.out, "runs", ".moderate_d30_BCF_a0_r0.tmp")))
+        self.assertTrue(all(r["status"] == "ok" for r in self.rows()))
+        # Other settings on the same folder are refused.
+        p = self.sweep("--set", "landing.speed=0.1")
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("other settings", p.stderr)
+        # Report only.
+        os.remove(os.path.join(self.out, "report.md"))
+        p = subprocess.run([sys.executable, SWEEP, "--out", self.out, "--report-only", "--spread", "sd"],
+                           capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        with open(os.path.join(self.out, "report.md")) as f:
+            text = f.read()
+        self.assertIn("| gravel | 0.3 | Flat | 60 | 2 | 1/2 |", text)
+
+    def test_missing_bed(self):
+        os.remove(os.path.join(self.beds, "mascot_gravel_d30.bed"))
+        p = self.sweep()
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("mascot_gravel_d30.bed", p.stderr)
+        self.assertIn("--set materials.regolith.preset=gravel", p.stderr)
+        self.assertIn("--set stages.1.trim_above=0.3", p.stderr)
+        self.assertFalse(os.path.exists(os.path.join(self.out, "runs")))
+
+    def test_plot_landing_without_contact(self):
+        run = os.path.join(self.dir, "run")
+        subprocess.run([sys.executable, FAKE, "x.yaml", "--out", run], check=True)
+        with open(os.path.join(run, "summary.json")) as f:
+            s = json.load(f)
+        s["outcome"].update(contact=False, lifted_off=False)
+        with open(os.path.join(run, "summary.json"), "w") as f:
+            json.dump(s, f)
+        p = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "plot_landing.py"), run],
+                           capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        for png in ("trajectory", "energy", "force", "surface"):
+            self.assertTrue(os.path.exists(os.path.join(run, png + ".png")), png)
+
+
+if __name__ == "__main__":
+    unittest.main()

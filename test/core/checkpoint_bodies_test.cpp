@@ -306,12 +306,15 @@ TEST(CheckpointBodies, PrimingDoesNotAdvanceBodyContactHistory) {
   ASSERT_GT(springs, 0);
   const auto grain_body_springs = sc.s.body_grains.spring_t;
   const auto grain_body_touching = sc.s.body_grains.touching;
+  // The free boxes moved since the last force pass (a restored or edited
+  // state): every point is found again at a new place on the plate.
+  for (int b : {1, 2}) sc.s.bodies[b].pos += Vec3(2e-5, -1e-5, 0);
   sc.s.forces_valid = false;
   rt::prime(sc.m, sc.s);
   ASSERT_EQ(sc.s.body_points.size(), before.size());
   for (size_t k = 0; k < before.size(); ++k) {
     EXPECT_TRUE(same_bits(sc.s.body_points[k].spring_t, before[k].spring_t)) << "point " << k;
-    EXPECT_TRUE(same_bits(sc.s.body_points[k].local_a, before[k].local_a)) << "point " << k;
+    EXPECT_NEAR((sc.s.body_points[k].local_b - before[k].local_b).norm(), 0.0, 1e-12) << "point " << k;
   }
   EXPECT_TRUE(same_bits(sc.s.body_grains.spring_t, grain_body_springs));
   EXPECT_TRUE(same_bits(sc.s.body_grains.touching, grain_body_touching));

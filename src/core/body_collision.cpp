@@ -145,6 +145,7 @@ struct BodyGeometry {
   std::vector<int> order, hull;
   std::vector<Candidate> cand;
   std::vector<int> match_new, match_old;
+  std::vector<uint8_t> taken;
   std::atomic<bool> busy{false};
 };
 
@@ -317,7 +318,7 @@ bool lex_less(const Vec3& u, const Vec3& v) {
 // centre of pressure (a box on two floor triangles also reports points along
 // their shared edge). A curved contact keeps its deepest point.
 void reduce_points(std::vector<RawPoint>& pts, double tol, int max_points, std::vector<RawPoint>& tmp,
-                   std::vector<int>& idx, std::vector<int>& hull) {
+                   std::vector<int>& idx, std::vector<int>& hull, std::vector<uint8_t>& taken) {
   std::sort(pts.begin(), pts.end(), [](const RawPoint& p, const RawPoint& q) {
     if (p.depth != q.depth) return p.depth > q.depth;
     return lex_less(p.local_a, q.local_a);
@@ -379,7 +380,7 @@ void reduce_points(std::vector<RawPoint>& pts, double tol, int max_points, std::
   if (static_cast<int>(pts.size()) > max_points) {
     tmp.clear();
     tmp.push_back(pts[0]);
-    std::vector<uint8_t> taken(pts.size(), 0);
+    taken.assign(pts.size(), 0);
     taken[0] = 1;
     while (static_cast<int>(tmp.size()) < max_points) {
       int best = -1;
@@ -457,8 +458,17 @@ void build_body_geometry(const Model& m) {
       g->body_reach[i] = std::max(g->body_reach[i], g->shapes[i].back().reach);
     }
   }
-  g->raw.reserve(64);
-  g->cand.reserve(64);
+  // Scratch capacity for one shape pair's reported points (a box on a few
+  // mesh triangles reports a few dozen); a query with more grows it once.
+  constexpr size_t kScratch = 256;
+  g->raw.reserve(kScratch);
+  g->raw_tmp.reserve(kScratch);
+  g->order.reserve(kScratch);
+  g->hull.reserve(2 * kScratch);
+  g->taken.reserve(kScratch);
+  g->cand.reserve(kScratch);
+  g->match_new.reserve(kScratch);
+  g->match_old.reserve(kScratch);
   m.body_geometry = std::move(g);
 }
 
@@ -533,7 +543,7 @@ void body_body_forces(const Model& m, State& s) {
           const double tol = narrow_phase(g, ta, tb, ea, eb, sa, sb);
           if (g.raw.empty()) continue;
           const int n_max = (ea.smooth || eb.smooth) ? 1 : kFacePoints;
-          reduce_points(g.raw, tol, n_max, g.raw_tmp, g.order, g.hull);
+          reduce_points(g.raw, tol, n_max, g.raw_tmp, g.order, g.hull, g.taken);
           const int n = static_cast<int>(g.raw.size());
           // Deterministic order: by the point's position on body a.
           std::sort(g.raw.begin(), g.raw.end(),
@@ -590,7 +600,8 @@ void body_body_forces(const Model& m, State& s) {
             c.shape_b = ib;
             c.local_a = p.local_a;
             c.local_b = p.local_b;
-            c.spring_t = g.match_new[i] >= 0 ? old[cursor + g.match_new[i]].spring_t : Vec3::Zero();
+            const Vec3 carried = g.match_new[i] >= 0 ? old[cursor + g.match_new[i]].spring_t : Vec3::Zero();
+            c.spring_t = carried;
             c.overlap = p.depth;
             c.normal = p.n;
             c.point = 0.5 * (p.on_a + p.on_b);
@@ -607,6 +618,7 @@ void body_body_forces(const Model& m, State& s) {
             Vec3 roll = Vec3::Zero();
             double twist = 0;
             const PairOutput f = pair_contact<ContactModel::Linear, false>(pl, in, PairSprings{c.spring_t, roll, twist}, m.dt);
+            if (s.hold_body_springs) c.spring_t = carried;  // priming pass: history not advanced
             c.force_a = f.force_i;
             sa.force += f.force_i;
             sa.torque += arm_a.cross(f.force_i);
@@ -621,6 +633,22 @@ void body_body_forces(const Model& m, State& s) {
     }
   }
   std::swap(s.body_points, s.body_points_next);
+}
+
+size_t max_body_points(const Model& m) {
+  auto smooth = [](ShapeType t) { return t == ShapeType::Sphere || t == ShapeType::Ellipsoid; };
+  size_t total = 0;
+  const size_t nb = m.bodies.size();
+  for (size_t a = 0; a < nb; ++a)
+    for (size_t b = a + 1; b < nb; ++b) {
+      if (m.bodies[a].fixed && m.bodies[b].fixed) continue;
+      for (const Shape& sa : m.bodies[a].shapes)
+        for (const Shape& sb : m.bodies[b].shapes) {
+          total += (smooth(sa.type) || smooth(sb.type)) ? 1 : kFacePoints;
+          if (total >= kMaxReservedBodyPoints) return kMaxReservedBodyPoints;
+        }
+    }
+  return total;
 }
 
 double body_body_elastic_energy(const Model& m, const State& s) {

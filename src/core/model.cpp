@@ -170,7 +170,6 @@ void finalize_model(Model& m) {
 
 std::vector<PairResolution> pair_resolution(const Model& m, double v_ref) {
   std::vector<PairResolution> out;
-  if (m.n_grains == 0) return out;
   // Smallest grain of each material.
   const int nm = m.n_materials();
   std::vector<double> mmin(nm, 0), rmin(nm, 0);
@@ -216,6 +215,20 @@ std::vector<PairResolution> pair_resolution(const Model& m, double v_ref) {
       const double ms = b.fixed ? mmin[a] : mmin[a] * b.mass / (mmin[a] + b.mass);
       const double tc = time_of(L, ms, rmin[a], L.eps_n);
       out.push_back({"grain-body (" + m.materials[a].name + "/" + b.name + ")", tc, tc / m.dt});
+    }
+  // Body–body pairs (at least one movable): the linear law of the pair at its
+  // full stiffness k_body (a face contact; an edge or a corner is softer and
+  // lasts longer), m* from the two masses, a fixed body counting as infinite.
+  const int nb = static_cast<int>(m.bodies.size());
+  const double k_body = m.body_kn > 0 ? m.body_kn : m.kn;
+  for (int a = 0; a < nb; ++a)
+    for (int b = a + 1; b < nb; ++b) {
+      const BodyModel& A = m.bodies[a];
+      const BodyModel& B = m.bodies[b];
+      if ((A.fixed && B.fixed) || !(k_body > 0)) continue;
+      const double ms = A.fixed ? B.mass : B.fixed ? A.mass : A.mass * B.mass / (A.mass + B.mass);
+      const double tc = linear_contact_time(ms, k_body, m.law(A.material, B.material).eps_n);
+      out.push_back({"body-body (" + A.name + "/" + B.name + ")", tc, tc / m.dt});
     }
   return out;
 }

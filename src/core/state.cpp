@@ -1,6 +1,8 @@
 // State construction: every buffer the step needs, sized once.
 #include "regolith_twin/core/state.hpp"
 
+#include "regolith_twin/core/body_collision.hpp"
+
 namespace rt {
 
 State make_state(const Model& m) {
@@ -44,6 +46,9 @@ State make_state(const Model& m) {
     l->spring_w.reserve(wall_cap);
     l->touching.reserve(wall_cap);
   }
+  // Grain–body candidates: head room for a quarter of the grains near a body
+  // shape (a body buried in the bed); a list that outgrows it reallocates at
+  // that rebuild, as the grain lists do, and keeps the larger capacity.
   const size_t body_cap = m.bodies.empty() ? 0 : size_t(n) / 4 + 256;
   for (BodyGrainList* l : {&s.body_grains, &s.body_grains_next}) {
     l->grain.reserve(body_cap);
@@ -55,6 +60,10 @@ State make_state(const Model& m) {
     l->spring_w.reserve(body_cap);
     l->touching.reserve(body_cap);
   }
+  // Body–body contact points: every point the shape pairs can have.
+  const size_t point_cap = max_body_points(m);
+  s.body_points.reserve(point_cap);
+  s.body_points_next.reserve(point_cap);
   s.cell_start.reserve(4 * size_t(n) + 66);
   s.cell_items.reserve(n);
   s.cell_of.reserve(n);

@@ -11,8 +11,9 @@ namespace rt {
 
 void prime(const Model& m, State& s) {
   build_neighbour_lists(m, s);
-  // Forces of the current state without advancing any spring: the springs
-  // are put back after the pass.
+  // Forces of the current state without advancing any contact history: the
+  // springs and touching flags of the lists are put back after the pass, and
+  // body–body points keep the springs they carried in (hold_body_springs).
   s.vel_mid = s.vel;
   s.omega_mid = s.omega;
   for (BodyState& b : s.bodies) {
@@ -22,22 +23,26 @@ void prime(const Model& m, State& s) {
   const PairList springs = s.pairs;
   const WallList wall_springs = s.wall_pairs;
   const BodyGrainList body_springs = s.body_grains;
-  const std::vector<BodyPointContact> body_points = s.body_points;
-  compute_forces(m, s);
+  s.hold_body_springs = true;  // body–body points keep the springs they carry in
+  try {
+    compute_forces(m, s);
+  } catch (...) {
+    s.hold_body_springs = false;
+    throw;
+  }
+  s.hold_body_springs = false;
   s.body_grains.spring_t = body_springs.spring_t;
   s.body_grains.spring_r = body_springs.spring_r;
   s.body_grains.spring_w = body_springs.spring_w;
-  for (size_t k = 0; k < s.body_points.size(); ++k)  // points matched to earlier ones keep their spring
-    for (const BodyPointContact& old : body_points)
-      if (old.a == s.body_points[k].a && old.b == s.body_points[k].b && old.shape_a == s.body_points[k].shape_a &&
-          old.shape_b == s.body_points[k].shape_b && old.local_a == s.body_points[k].local_a)
-        s.body_points[k].spring_t = old.spring_t;
+  s.body_grains.touching = body_springs.touching;
   s.pairs.spring_t = springs.spring_t;
   s.pairs.spring_r = springs.spring_r;
   s.pairs.spring_w = springs.spring_w;
+  s.pairs.touching = springs.touching;
   s.wall_pairs.spring_t = wall_springs.spring_t;
   s.wall_pairs.spring_r = wall_springs.spring_r;
   s.wall_pairs.spring_w = wall_springs.spring_w;
+  s.wall_pairs.touching = wall_springs.touching;
 }
 
 void step(const Model& m, State& s) {

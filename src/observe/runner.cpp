@@ -140,6 +140,7 @@ RunReport run_scenario(Scenario& sc, State& s, const RunOptions& opt) {
         // Same steps per contact at the new stiffness. Live springs keep their
         // extension; the law table is rebuilt for the new k_n.
         sc.model.kn = sc.scene_kn * st.stiffness_scale;
+        if (sc.scene_body_kn > 0) sc.model.body_kn = sc.scene_body_kn * st.stiffness_scale;
         sc.model.dt = sc.scene_dt / std::sqrt(st.stiffness_scale);
         finalize_model(sc.model);
         s.forces_valid = false;

@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -104,7 +105,9 @@ void save_checkpoint(const std::string& path, const Model& m, const State& s) {
   w.pod(s.time);
   w.pod<int64_t>(s.step);
   w.pod<int64_t>(s.rebuilds);
-  w.pod<uint8_t>(s.lists_valid && s.forces_valid);
+  // Flags: bit 0 the lists and forces are live (loading continues without a
+  // priming pass), bit 1 a list rebuild is pending (walls switched on or off).
+  w.pod<uint8_t>(uint8_t((s.lists_valid && s.forces_valid ? 1 : 0) | (s.rebuild_requested ? 2 : 0)));
   w.pod(s.stats.max_disp2);
   for (const auto* v : {&s.pos, &s.vel, &s.omega, &s.force, &s.torque, &s.pos_at_build}) w.vec(*v);
   w.vec(s.pairs.row_start);
@@ -146,8 +149,9 @@ State load_checkpoint(const std::string& path, const Model& m) {
   in.seekg(0);
   if (!in.read(data.data(), data.size())) throw InputError(path + ": cannot read checkpoint");
   Reader r(path, data);
-  if (data.size() < sizeof kMagic + 8 || std::memcmp(data.data(), kMagic, sizeof kMagic) != 0)
-    r.fail("wrong file type (no checkpoint header)");
+  const size_t head = std::min(data.size(), sizeof kMagic);
+  if (std::memcmp(data.data(), kMagic, head) != 0 || data.empty()) r.fail("wrong file type (no checkpoint header)");
+  if (data.size() < sizeof kMagic + sizeof(uint32_t) + 8) r.fail("truncated file (shorter than the header)");
   uint64_t stored_sum;
   std::memcpy(&stored_sum, data.data() + data.size() - 8, 8);
   if (fnv1a(data.data(), data.size() - 8) != stored_sum) r.fail("checksum mismatch (truncated or corrupted file)");
@@ -164,7 +168,9 @@ State load_checkpoint(const std::string& path, const Model& m) {
   s.time = r.pod<double>();
   s.step = r.pod<int64_t>();
   s.rebuilds = r.pod<int64_t>();
-  const bool live = r.pod<uint8_t>() != 0;
+  const uint8_t flags = r.pod<uint8_t>();
+  const bool live = (flags & 1) != 0;
+  s.rebuild_requested = (flags & 2) != 0;
   s.stats.max_disp2 = r.pod<double>();
   for (auto* v : {&s.pos, &s.vel, &s.omega, &s.force, &s.torque, &s.pos_at_build}) r.vec(*v, n);
   r.vec(s.pairs.row_start);

@@ -642,7 +642,7 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
 
   // Contact law, stiffness and time step.
   const YAML::Node c = rd.map(root, "", "contact", false);
-  rd.only(c, "contact", {"model", "kn", "v_max", "x_max", "steps_per_contact", "dt", "skin", "partitions"});
+  rd.only(c, "contact", {"model", "kn", "body_kn", "v_max", "x_max", "steps_per_contact", "dt", "skin", "partitions"});
   m.contact_model = rd.choice(c, "contact", "model", "linear", {"linear", "hertz_mindlin"}) == "linear"
                         ? ContactModel::Linear
                         : ContactModel::HertzMindlin;
@@ -674,6 +674,8 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   } else {
     rd.fail("contact.dt", "missing: the Hertz–Mindlin law needs an explicit dt");
   }
+  // Body–body stiffness of one shape pair (MODEL.md §6); absent: the scene k_n.
+  m.body_kn = rd.number(c, "contact", "body_kn", 0, 0, kInf, true);
   m.skin = rd.number(c, "contact", "skin", 0, 0, kInf);
   m.partitions = int(rd.integer(c, "contact", "partitions", 4, 1, 256));
 
@@ -684,6 +686,7 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
 
   finalize_model(m);
   sc.scene_kn = m.kn;
+  sc.scene_body_kn = m.body_kn;
   sc.scene_dt = m.dt;
 
   // Resolution report: warn below 10 steps per contact, refuse below 4.

@@ -1,7 +1,9 @@
 // The step allocates no memory once its buffers are sized (state.hpp): after a
 // warm-up, thousands of steps of a flowing scene, neighbour-list rebuilds
-// included, make no call to operator new. This binary replaces the global
-// operator new/delete to count calls.
+// included, make no call to operator new; with rigid bodies (grain–body and
+// body–body contacts) neither the engine nor Bullet allocates. This binary
+// replaces the global operator new/delete to count calls.
+#include <LinearMath/btAlignedAllocator.h>
 #include <gtest/gtest.h>
 #include <omp.h>
 #include <unistd.h>
@@ -18,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "regolith_twin/core/body.hpp"
 #include "regolith_twin/core/walls.hpp"
 #include "regolith_twin/scene/generate.hpp"
 #include "regolith_twin/scene/scenario.hpp"
@@ -40,6 +43,15 @@ void* counted_aligned_alloc(std::size_t n, std::align_val_t al) {
   if (posix_memalign(&p, a, n ? n : 1) == 0) return p;
   throw std::bad_alloc();
 }
+
+// Bullet's own heap calls (btAlignedAlloc, used by its containers and pool
+// fallbacks) bypass operator new: they are counted through Bullet's hook.
+std::atomic<long> g_bullet_allocations{0};
+void* counted_bullet_alloc(std::size_t n) {
+  g_bullet_allocations.fetch_add(1, std::memory_order_relaxed);
+  return std::malloc(n ? n : 1);
+}
+void bullet_free(void* p) { std::free(p); }
 
 }  // namespace
 
@@ -166,6 +178,119 @@ void expect_steps_allocate_nothing(int threads, int parallel_min_grains) {
 
 }  // namespace
 
+namespace {
+
+rt::BodyModel box_body(const std::string& name, const Vec3& half, bool fixed) {
+  rt::BodyModel b;
+  b.name = name;
+  b.fixed = fixed;
+  b.material = 1;
+  b.mass = 8 * half.prod() * 2000;
+  b.inertia = b.mass / 3 *
+              Vec3(half.y() * half.y() + half.z() * half.z(), half.x() * half.x() + half.z() * half.z(),
+                   half.x() * half.x() + half.y() * half.y());
+  rt::Shape sh;
+  sh.type = rt::ShapeType::Box;
+  sh.size = half;
+  b.shapes.push_back(sh);
+  return b;
+}
+
+// 1200 'moderate' grains thrown down between four plane walls onto a fixed
+// plate body, around a free box sliding and spinning on the plate and a
+// second free box that lands on it, under tilted gravity: grain–body
+// contacts on all three bodies and body–body contacts (plate–box, box–box).
+Scene make_body_scene(int parallel_min_grains) {
+  Scene sc;
+  rt::Model& m = sc.m;
+  rt::Material grain;
+  EXPECT_TRUE(rt::material_preset("moderate", grain));
+  m.materials.push_back(grain);
+  rt::Material structure = rt::test::simple_material("structure", 2000, 0.4, 0.4, 0.6);
+  structure.structure = true;
+  m.materials.push_back(structure);
+  const double L = 0.06;
+  m.walls.push_back(rt::make_plane(Vec3(-L, 0, 0), Vec3::UnitX(), 1));
+  m.walls.push_back(rt::make_plane(Vec3(L, 0, 0), -Vec3::UnitX(), 1));
+  m.walls.push_back(rt::make_plane(Vec3(0, -L, 0), Vec3::UnitY(), 1));
+  m.walls.push_back(rt::make_plane(Vec3(0, L, 0), -Vec3::UnitY(), 1));
+  const Vec3 half_a(0.03, 0.025, 0.015), half_b(0.012, 0.012, 0.01);
+  m.bodies.push_back(box_body("plate", Vec3(0.1, 0.1, 0.01), true));
+  m.bodies.push_back(box_body("box_a", half_a, false));
+  m.bodies.push_back(box_body("box_b", half_b, false));
+  // Box b starts 2 mm above box a and lands on it during the measured window:
+  // the body–body point list grows in steady state.
+  const Vec3 pos_a(0.0, 0.0, half_a.z() - 5e-5), pos_b = pos_a + Vec3(0.006, 0.003, half_a.z() + half_b.z() + 2e-3);
+  std::mt19937_64 rng(7);
+  rt::RadiusDist d;
+  d.mean = 0.003;
+  d.sigma = 0.1;
+  rt::Region region;
+  region.lo = Vec3(-L, -L, 3e-4);  // the first layer just clear of the plate
+  region.hi = Vec3(L, L, 0.15);
+  const int n = 1200;
+  const std::vector<Vec3> sites = rt::lattice_sites(region, 2.02 * d.max(), d.max(), 0.0, 4 * n, rng);
+  std::vector<Vec3> kept;
+  for (const Vec3& p : sites) {
+    if (int(kept.size()) == n) break;
+    const bool clear_a = rt::shape_gap(m.bodies[1], m.bodies[1].shapes[0], p - pos_a, d.max()).overlap < -3e-4;
+    const bool clear_b = rt::shape_gap(m.bodies[2], m.bodies[2].shapes[0], p - pos_b, d.max()).overlap < -3e-4;
+    if (clear_a && clear_b) kept.push_back(p);
+  }
+  EXPECT_EQ(int(kept.size()), n);
+  const std::vector<double> radii = rt::draw_radii(d, n, rng);
+  for (int i = 0; i < n; ++i) rt::add_grain(m, radii[i], 0);
+  const double m_p = 4.0 / 3.0 * M_PI * std::pow(d.mean, 3) * grain.density;
+  m.kn = 2e4;
+  m.body_kn = 5e4;
+  m.dt = rt::dt_rule(m_p, m.kn, 30);
+  m.gravity = Vec3(1.5, 0.5, -9.81);
+  m.parallel_min_grains = parallel_min_grains;
+  rt::finalize_model(m);
+  sc.s = rt::make_state(m);
+  std::normal_distribution<double> v(0.0, 0.1);
+  for (int i = 0; i < n; ++i) {
+    sc.s.pos[i] = kept[i];
+    sc.s.vel[i] = Vec3(v(rng), v(rng), v(rng) - 0.5);
+  }
+  sc.s.bodies[0].pos = Vec3(0, 0, -0.01);
+  sc.s.bodies[1].pos = pos_a;
+  sc.s.bodies[2].pos = pos_b;
+  rt::set_body_velocity(m.bodies[1], sc.s.bodies[1], Vec3(0.05, 0.02, 0), Vec3(0, 0, 0.8));
+  rt::set_body_velocity(m.bodies[2], sc.s.bodies[2], Vec3(-0.03, 0.01, -0.2), Vec3(0, 0, -1.0));
+  return sc;
+}
+
+void expect_body_steps_allocate_nothing(int threads, int parallel_min_grains) {
+  omp_set_num_threads(threads);
+  Scene sc = make_body_scene(parallel_min_grains);
+  for (int k = 0; k < 300; ++k) rt::step(sc.m, sc.s);  // warm-up (thread pool, first lists)
+  constexpr int kWindow = 3000;
+  for (const auto& p : sc.s.body_points) EXPECT_FALSE(p.a == 1 && p.b == 2) << "box b landed during the warm-up";
+  const long rebuilds0 = sc.s.rebuilds, body_rebuilds0 = sc.s.body_rebuilds;
+  long body_contacts = 0, body_body = 0, box_box = 0;
+  btAlignedAllocSetCustom(counted_bullet_alloc, bullet_free);
+  const long before = g_allocations.load(), bullet_before = g_bullet_allocations.load();
+  for (int k = 0; k < kWindow; ++k) {
+    rt::step(sc.m, sc.s);
+    body_contacts += sc.s.stats.body_contacts;
+    body_body += sc.s.stats.body_body_contacts;
+    for (const auto& p : sc.s.body_points) box_box += p.a == 1 && p.b == 2;
+  }
+  const long allocations = g_allocations.load() - before;
+  const long bullet_allocations = g_bullet_allocations.load() - bullet_before;
+  EXPECT_EQ(allocations, 0) << "operator new called during " << threads << "-thread steps with bodies";
+  EXPECT_EQ(bullet_allocations, 0) << "Bullet allocated during " << threads << "-thread steps with bodies";
+  // The window covered list rebuilds and live grain–body and body–body contacts.
+  EXPECT_GE(sc.s.rebuilds - rebuilds0, 3);
+  EXPECT_GE(sc.s.body_rebuilds - body_rebuilds0, 3);
+  EXPECT_GT(body_contacts / kWindow, 20);  // mean live grain–body contacts per step
+  EXPECT_GE(body_body / kWindow, 4);       // mean body–body points per step
+  EXPECT_GT(box_box, kWindow / 2);          // the two free boxes touch through most of the window
+}
+
+}  // namespace
+
 TEST(Allocation, CounterSeesOperatorNew) {
   const long before = g_allocations.load();
   std::vector<double>* v = new std::vector<double>(100);
@@ -176,3 +301,7 @@ TEST(Allocation, CounterSeesOperatorNew) {
 TEST(Allocation, SerialStepsAllocateNothing) { expect_steps_allocate_nothing(1, 1 << 30); }
 
 TEST(Allocation, ParallelStepsAllocateNothing) { expect_steps_allocate_nothing(2, 0); }
+
+TEST(Allocation, SerialStepsWithBodiesAllocateNothing) { expect_body_steps_allocate_nothing(1, 1 << 30); }
+
+TEST(Allocation, ParallelStepsWithBodiesAllocateNothing) { expect_body_steps_allocate_nothing(2, 0); }

@@ -65,10 +65,22 @@ void build_body_geometry(const Model& m);
 // Find the contact points of every pair of bodies (at least one movable),
 // carry the tangential history of points that persist, and add the forces
 // and torques to State::bodies[].force / torque (about each centre of mass;
-// the caller zeroes them). Part of the force stage. Uses
+// the caller zeroes them). Part of the force stage. With
+// State::hold_body_springs set (prime()), each point keeps the spring it
+// carried into the pass: forces are evaluated, the history is not advanced. Uses
 // BodyState::vel/omega (predicted end of step) for the dashpots and
 // vel_mid/omega_mid for the spring increments.
 void body_body_forces(const Model& m, State& s);
+
+// Largest number of body–body contact points the bodies of m can have at once
+// (every shape pair of two bodies, at least one movable, at its n_max), capped
+// at kMaxReservedBodyPoints. make_state reserves State::body_points (and its
+// double buffer) for this many, so body_body_forces does not allocate; beyond
+// the cap the list may grow (and reallocate) like the grain lists. Scratch of
+// the query lives in the geometry (reserved for 256 reported points per shape
+// pair; a query with more grows it once).
+constexpr size_t kMaxReservedBodyPoints = size_t(1) << 16;
+size_t max_body_points(const Model& m);
 
 // Elastic energy stored in the body–body contacts of the last force pass
 // (1/2 k_n/n x^2 + 1/2 k_t/n |S|^2 per point), J.

@@ -141,7 +141,13 @@ struct State {
   BodyGrainList body_grains, body_grains_next;
   double body_list_grain_disp = 0;  // max grain displacement (since pos_at_build) when body_grains was built, m
   long body_rebuilds = 0;
+  // body_points, body_points_next: capacity for every point the bodies'
+  // shape pairs can have (make_state), so the step does not allocate.
   std::vector<BodyPointContact> body_points, body_points_next;
+  // Set by prime() during its force pass: body_body_forces stores the spring
+  // each point carried into the pass, not the advanced one (the pass
+  // evaluates forces without moving the contact history forward).
+  bool hold_body_springs = false;
 
   StepStats stats;
   bool log_contacts = false;  // record every contact of each force pass in scratch[p].log

@@ -56,6 +56,7 @@ struct Scenario {
   std::vector<PairResolution> resolution;  // steps per contact of every pair type
   std::vector<std::string> warnings;  // non-fatal remarks (under-resolved contacts, ...)
   double scene_kn = 0, scene_dt = 0;  // k_n and dt as parsed (stages may scale the model's)
+  double scene_body_kn = 0;           // contact.body_kn as parsed (0: the scene k_n; stages scale it too)
   const GrainGroup* group(const std::string& name) const;
 };
 

@@ -186,6 +186,19 @@ RunReport run_scenario(Scenario& sc, State& s, const RunOptions& opt) {
           next_sample += sc.output_every;
         }
         step(m, s);
+        if (st.minimize) {
+          const int n = m.n_grains;
+          const Vec3 g = m.gravity;
+#pragma omp parallel for schedule(static) if (n >= m.parallel_min_grains)
+          for (int i = 0; i < n; ++i) {
+            if (m.grain_inv_mass[i] == 0) continue;
+            const Vec3 f = s.force[i] + g / m.grain_inv_mass[i];
+            const double p = s.vel[i].dot(f), f2 = f.squaredNorm();
+            s.vel[i] = p > 0 && f2 > 0 ? Vec3(f * (p / f2)) : Vec3::Zero();
+            const double pw = s.omega[i].dot(s.torque[i]), t2 = s.torque[i].squaredNorm();
+            s.omega[i] = pw > 0 && t2 > 0 ? Vec3(s.torque[i] * (pw / t2)) : Vec3::Zero();
+          }
+        }
         if (st.quench_every > 0 && s.time >= next_quench - 0.5 * m.dt) {
           next_quench += st.quench_every;
           for (int i = 0; i < m.n_grains; ++i) {

@@ -39,6 +39,9 @@ struct Stage {
                                       //      (softer springs for bed preparation); 0: keep the current values
   double quench_every = 0;            // > 0: every this many seconds, all grain velocities and spins are
                                       //      set to zero (bed preparation: a quasi-static descent)
+  bool minimize = false;              // after every step, each grain keeps only the part of its velocity
+                                      //   along its net force, none if it moves against it (quick-min:
+                                      //   a damped descent to static equilibrium for bed preparation)
   bool trim = false;                  // remove grains at the start of the stage
   double trim_above = 0;              // ... whose centre lies above this height (z), m
 };

@@ -205,7 +205,7 @@ ShapeGap shape_gap(const BodyModel& b, const Shape& sh, const Vec3& p, double r)
     case ShapeType::Box: g = box_gap(ps, sh.size, r); break;
     case ShapeType::Cylinder: g = cylinder_gap(ps, sh.size.x(), sh.size.z(), r); break;
     case ShapeType::Ellipsoid: g = ellipsoid_gap(ps, sh.size, r); break;
-    case ShapeType::Mesh: return g;  // meshes are contacted through their triangle list (body_mesh.cpp)
+    case ShapeType::Mesh: return g;  // grain–mesh contact is not implemented: finalize_model refuses such scenes
   }
   g.n = sh.rot * g.n;
   g.point = sh.pos + sh.rot * g.point;

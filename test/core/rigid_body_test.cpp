@@ -260,3 +260,33 @@ TEST(RigidBody, GrainBodyContactConservesMomentum) {
   EXPECT_LT(d.p_err, 1e-12);
   EXPECT_LT(d.l_err, 1e-9);
 }
+
+TEST(RigidBody, GrainsWithAMeshBodyAreRefused) {
+  // Grain–mesh contact is not implemented: such a scene must be refused
+  // rather than let grains pass through the mesh.
+  rt::Model m;
+  m.materials = {rt::test::simple_material("grain", 2500, 0.5, 0.5, 0.5)};
+  m.kn = 1e4;
+  m.dt = 1e-5;
+  rt::add_grain(m, 0.01, 0);
+  BodyModel b;
+  b.name = "meshy";
+  b.mass = 1;
+  b.inertia = Vec3(1, 1, 1);
+  b.meshes.resize(1);
+  b.meshes[0].vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
+  b.meshes[0].triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  Shape sh;
+  sh.type = ShapeType::Mesh;
+  sh.mesh = 0;
+  sh.link = "hull";
+  b.shapes = {sh};
+  m.bodies.push_back(b);
+  try {
+    rt::finalize_model(m);
+    FAIL() << "a mesh body with grains was accepted";
+  } catch (const rt::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("meshy"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("mesh"), std::string::npos) << e.what();
+  }
+}

@@ -199,6 +199,12 @@ RunReport run_scenario(Scenario& sc, State& s, const RunOptions& opt) {
             s.omega[i] = pw > 0 && t2 > 0 ? Vec3(s.torque[i] * (pw / t2)) : Vec3::Zero();
           }
         }
+        if (st.release_springs) {
+          for (auto* l : {&s.pairs.spring_t, &s.pairs.spring_r, &s.wall_pairs.spring_t, &s.wall_pairs.spring_r})
+            std::fill(l->begin(), l->end(), Vec3::Zero());
+          std::fill(s.pairs.spring_w.begin(), s.pairs.spring_w.end(), 0.0);
+          std::fill(s.wall_pairs.spring_w.begin(), s.wall_pairs.spring_w.end(), 0.0);
+        }
         if (st.quench_every > 0 && s.time >= next_quench - 0.5 * m.dt) {
           next_quench += st.quench_every;
           for (int i = 0; i < m.n_grains; ++i) {

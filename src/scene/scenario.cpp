@@ -716,7 +716,7 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
       const std::string p = "stages[" + std::to_string(i) + "]";
       rd.only(st[i], p,
               {"name", "duration", "hold", "remove_walls", "until_rms_speed", "until_max_speed", "check_every",
-               "gravity", "gravity_ramp", "trim_above", "stiffness_scale", "quench_every", "minimize"});
+               "gravity", "gravity_ramp", "trim_above", "stiffness_scale", "quench_every", "minimize", "release_springs"});
       Stage s;
       s.name = rd.text(st[i], p, "name", "stage" + std::to_string(i));
       s.duration = rd.number(st[i], p, "duration", 0, 0, 1e9, true);
@@ -751,6 +751,7 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
       s.stiffness_scale = rd.number(st[i], p, "stiffness_scale", 0, 0, 1);
       s.quench_every = rd.number(st[i], p, "quench_every", 0, 0, kInf);
       s.minimize = rd.boolean(st[i], p, "minimize", false);
+      s.release_springs = rd.boolean(st[i], p, "release_springs", false);
       if (st[i]["trim_above"]) {
         s.trim = true;
         s.trim_above = rd.number(st[i], p, "trim_above", 0, -kInf, kInf);

@@ -42,6 +42,9 @@ struct Stage {
   bool minimize = false;              // after every step, each grain keeps only the part of its velocity
                                       //   along its net force, none if it moves against it (quick-min:
                                       //   a damped descent to static equilibrium for bed preparation)
+  bool release_springs = false;       // with minimize: tangential, rolling and twisting springs are
+                                      //   emptied after every step, so frictional contacts cannot hold
+                                      //   the overlaps of a higher gravity while it is lowered
   bool trim = false;                  // remove grains at the start of the stage
   double trim_above = 0;              // ... whose centre lies above this height (z), m
 };

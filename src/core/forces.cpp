@@ -411,6 +411,16 @@ void pair_rows_batched(const Model& m, State& s, int rb, int re, Vec3* __restric
   sc.max_overlap_grain = r.max_grain;
 }
 
+// A list entry whose contact ended loses its spring history.
+template <class List>
+inline void end_contact(List& l, int k) {
+  if (!l.touching[k]) return;
+  l.touching[k] = 0;
+  l.spring_t[k].setZero();
+  l.spring_r[k].setZero();
+  l.spring_w[k] = 0;
+}
+
 // Grain–wall contacts of wall-list entries [kb, ke) into State::force.
 template <ContactModel M, bool Resist>
 void wall_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
@@ -422,12 +432,7 @@ void wall_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
     const double ri = m.grain_radius[i];
     const WallGap gap = wall_gap(w, s.pos[i], ri);
     if (gap.overlap <= 0) {
-      if (wl.touching[k]) {
-        wl.touching[k] = 0;
-        wl.spring_t[k].setZero();
-        wl.spring_r[k].setZero();
-        wl.spring_w[k] = 0;
-      }
+      end_contact(wl, k);
       continue;
     }
     wl.touching[k] = 1;
@@ -476,12 +481,7 @@ void body_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
     const double ri = m.grain_radius[i];
     const ShapeGap gap = shape_gap(bm, bm.shapes[bl.shape[k]], bs.q.conjugate() * (s.pos[i] - bs.pos), ri);
     if (gap.overlap <= 0) {
-      if (bl.touching[k]) {
-        bl.touching[k] = 0;
-        bl.spring_t[k].setZero();
-        bl.spring_r[k].setZero();
-        bl.spring_w[k] = 0;
-      }
+      end_contact(bl, k);
       continue;
     }
     bl.touching[k] = 1;

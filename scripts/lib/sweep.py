@@ -69,8 +69,8 @@ def bed_file(bed_dir, mat, depth):
 
 
 def fill_count(depth):
-    """Grains to generate for a bed trimmed at `depth` (80000 for the 0.30 m default)."""
-    return 1000 * math.ceil(80 * (depth + 0.05) / 0.35)
+    """Grains to generate for a bed trimmed at `depth` (75000 for the 0.30 m default)."""
+    return 1000 * math.ceil(75 * (depth + 0.05) / 0.35)
 
 
 def bed_command(sim, mat, depth, path):

@@ -202,6 +202,22 @@ void place_lander(const Model& m, State& s, int b, const LandingSpec& sp) {
   const Vec3 vdir = std::sin(a) * h - std::cos(a) * Vec3::UnitZ();
   const Vec3 contact = Vec3(sp.aim.x(), sp.aim.y(), sp.rim) - (sp.clearance / std::cos(a)) * vdir;
   bs.pos = contact - low;
+  // Back off along the approach line from grains closer than the clearance.
+  for (int iter = 0; iter < 200; ++iter) {
+    double worst = 0, along = 1;
+    for (int i = 0; i < m.n_grains; ++i) {
+      const Vec3 p = bs.q.conjugate() * (s.pos[i] - bs.pos);
+      for (const Shape& sh : bm.shapes) {
+        const ShapeGap g = shape_gap(bm, sh, p, m.grain_radius[i]);
+        if (g.overlap + sp.clearance > worst) {
+          worst = g.overlap + sp.clearance;
+          along = std::fabs(vdir.dot(bs.q * g.n));
+        }
+      }
+    }
+    if (worst <= 0) break;
+    bs.pos -= (worst / std::max(along, 0.2) + 1e-6) * vdir;
+  }
   set_body_velocity(bm, bs, sp.speed * vdir, Vec3::Zero());
   bs.force.setZero();
   bs.torque.setZero();

@@ -95,13 +95,54 @@ TEST(Landing, PlacementFollowsAttitudeAngleAndAim) {
     EXPECT_NEAR(hit.x(), sp.aim.x(), 1e-12);
     EXPECT_NEAR(hit.y(), sp.aim.y(), 1e-12);
     const Vec3 rel = corners[low] - s.bodies[0].pos;
-    if (a == rt::Attitude::BCF) EXPECT_LT(rel.x(), -0.05) << "back corner first: behind the centre of mass";
-    if (a == rt::Attitude::FCF) EXPECT_GT(rel.x(), 0.05) << "front corner first: ahead of the centre of mass";
+    if (a == rt::Attitude::BCF) {
+      EXPECT_LT(rel.x(), -0.05) << "back corner first: behind the centre of mass";
+    }
+    if (a == rt::Attitude::FCF) {
+      EXPECT_GT(rel.x(), 0.05) << "front corner first: ahead of the centre of mass";
+    }
     if (a == rt::Attitude::Flat) {
       int at_bottom = 0;
       for (const Vec3& c : corners) at_bottom += std::fabs(c.z() - corners[low].z()) < 1e-12;
       EXPECT_EQ(at_bottom, 4) << "flat: the bottom face is level";
     }
+  }
+}
+
+TEST(Landing, PlacementBacksOffFromGrainsAboveTheTrimPlane) {
+  // Trimming keeps centres below the rim, so grain tops stick out of it: a
+  // lander placed at the clearance above the rim would start inside them.
+  const double rim = 0.3;
+  rt::Model m = lander_scene(rim, 0.6);
+  rt::State s = layer_state(m, rim);
+  for (int i = 0; i < m.n_grains; ++i) s.pos[i].z() = rim - 0.2 * m.grain_radius[i];  // tops above the rim
+  rt::LandingSpec sp;
+  sp.lander = "lander";
+  sp.rim = rim;
+  sp.speed = 0.19;
+  sp.clearance = 0.002;
+  for (double angle : {0.0, 30.0, 60.0}) {
+    sp.angle_deg = angle;
+    sp.attitude = rt::Attitude::BCF;
+    rt::place_lander(m, s, 0, sp);
+    const rt::BodyModel& bm = m.bodies[0];
+    const rt::BodyState& bs = s.bodies[0];
+    double closest = 1e300;
+    for (int i = 0; i < m.n_grains; ++i)
+      for (const rt::Shape& sh : bm.shapes)
+        closest = std::min(closest, -rt::shape_gap(bm, sh, bs.q.conjugate() * (s.pos[i] - bs.pos),
+                                                   m.grain_radius[i]).overlap);
+    EXPECT_GE(closest, sp.clearance - 1e-9) << "angle " << angle;
+    EXPECT_LT(closest, sp.clearance + 0.01) << "angle " << angle << ": not moved back further than needed";
+    // Still on the approach line through the aim point.
+    const auto corners = rt::lander_corners(m, s, 0);
+    int low = 0;
+    for (int c = 1; c < 8; ++c)
+      if (corners[c].z() < corners[low].z()) low = c;
+    const Vec3 v = bs.vel;
+    const Vec3 hit = corners[low] + v * ((corners[low].z() - rim) / -v.z());
+    EXPECT_NEAR(hit.x(), sp.aim.x(), 1e-9);
+    EXPECT_NEAR(hit.y(), sp.aim.y(), 1e-9);
   }
 }
 

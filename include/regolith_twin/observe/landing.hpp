@@ -66,7 +66,10 @@ Perturbation perturbation(const LandingSpec& spec, double mean_radius);
 
 // Place the lander body (index b) for the spec: attitude, the lowest point
 // `clearance` above the trim plane on the line of approach through the aim
-// point, velocity `speed` at `angle_deg` from the vertical, no spin.
+// point, velocity `speed` at `angle_deg` from the vertical, no spin. Grains
+// stick out of the trim plane (trimming keeps every centre below it), so the
+// lander is then moved back along the approach line until every grain is at
+// least `clearance` away from it.
 void place_lander(const Model& m, State& s, int b, const LandingSpec& spec);
 
 // World positions of the eight corners of the lander's largest box shape.

@@ -442,7 +442,7 @@ Shape parse_shape(const Reader& rd, const YAML::Node& n, const std::string& path
 void parse_body(const Reader& rd, Scenario& sc, const YAML::Node& n, const std::string& path) {
   rd.only(n, path,
           {"name", "urdf", "link_box", "shapes", "mass", "inertia", "center_of_mass", "fixed", "material", "position",
-           "orientation", "velocity", "omega"});
+           "orientation", "velocity", "omega", "carve"});
   Model& m = sc.model;
   BodyModel b;
   const bool from_urdf = bool(n["urdf"]);
@@ -496,6 +496,7 @@ void parse_body(const Reader& rd, Scenario& sc, const YAML::Node& n, const std::
   const Vec3 v = rd.vec3(n, path, "velocity", Vec3::Zero()), w = rd.vec3(n, path, "omega", Vec3::Zero());
   for (const auto& other : m.bodies)
     if (other.name == b.name) rd.fail(Reader::join(path, "name"), "duplicate body name '" + b.name + "'");
+  if (rd.boolean(n, path, "carve", false)) sc.carve.push_back(int(m.bodies.size()));
   m.bodies.push_back(b);
   set_body_velocity(m.bodies.back(), bs, v, w);
   sc.initial.bodies.push_back(bs);
@@ -708,6 +709,20 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   sc.initial.pos = pos;
   sc.initial.vel = vel;
   sc.initial.omega = omg;
+
+  // Bodies buried in a bed ('carve: true'): the grains they overlap make room.
+  if (!sc.carve.empty()) {
+    std::vector<uint8_t> drop(m.n_grains, 0);
+    for (const int b : sc.carve) {
+      const BodyModel& bm = m.bodies[b];
+      const BodyState& bs = sc.initial.bodies[b];
+      for (int i = 0; i < m.n_grains; ++i)
+        for (const Shape& sh : bm.shapes)
+          if (shape_gap(bm, sh, bs.q.conjugate() * (sc.initial.pos[i] - bs.pos), m.grain_radius[i]).overlap > 0)
+            drop[i] = 1;
+    }
+    sc.carved_grains = remove_grains(sc, sc.initial, drop);
+  }
 
   // Stages.
   if (const YAML::Node st = root["stages"]) {

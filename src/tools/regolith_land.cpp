@@ -47,8 +47,9 @@ uint64_t fnv(const void* p, size_t n, uint64_t h) {
   return h;
 }
 
-// Key of a relaxed bed: grains, initial positions, materials, walls, gravity, k_n, dt.
-std::string bed_key(const rt::Model& m, const rt::State& s) {
+// Key of a relaxed bed: grains, initial positions, materials, walls, bodies
+// other than the lander (boulders), gravity, k_n, dt.
+std::string bed_key(const rt::Model& m, const rt::State& s, int lander) {
   uint64_t h = 1469598103934665603ULL;
   h = fnv(m.grain_radius.data(), m.grain_radius.size() * sizeof(double), h);
   h = fnv(s.pos.data(), s.pos.size() * sizeof(rt::Vec3), h);
@@ -59,6 +60,18 @@ std::string bed_key(const rt::Model& m, const rt::State& s) {
   for (const auto& w : m.walls) {
     const double v[] = {w.origin.x(), w.origin.y(), w.origin.z(), w.axis.x(), w.axis.y(), w.axis.z(), w.radius, w.length};
     h = fnv(v, sizeof v, h);
+  }
+  for (size_t k = 0; k < m.bodies.size(); ++k) {
+    if (int(k) == lander) continue;
+    const rt::BodyModel& bm = m.bodies[k];
+    const rt::BodyState& bs = s.bodies[k];
+    const double v[] = {bm.mass, bm.inertia.x(), bm.inertia.y(), bm.inertia.z(), double(bm.fixed), double(bm.material),
+                        bs.pos.x(), bs.pos.y(), bs.pos.z(), bs.q.w(), bs.q.x(), bs.q.y(), bs.q.z()};
+    h = fnv(v, sizeof v, h);
+    for (const rt::Shape& sh : bm.shapes) {
+      const double w[] = {double(sh.type), sh.size.x(), sh.size.y(), sh.size.z(), sh.pos.x(), sh.pos.y(), sh.pos.z()};
+      h = fnv(w, sizeof w, h);
+    }
   }
   const double v[] = {m.gravity.x(), m.gravity.y(), m.gravity.z(), m.kn, m.dt, m.skin, double(m.partitions)};
   h = fnv(v, sizeof v, h);
@@ -145,6 +158,8 @@ int main(int argc, char** argv) {
     if (out.empty()) out = "out/" + sc.name;
     make_dirs(out);
     for (const auto& w : sc.warnings) std::fprintf(stderr, "regolith_land: warning: %s\n", w.c_str());
+    if (!quiet && sc.carved_grains > 0)
+      std::fprintf(stderr, "[landing] %d grains removed to make room for buried bodies\n", sc.carved_grains);
     if (!quiet) {
       std::fprintf(stderr, "[landing] %d grains, dt = %.4g s, k_n = %.4g N/m, g = %.4g m/s^2\n", m.n_grains, m.dt, m.kn,
                    m.gravity.norm());
@@ -157,7 +172,7 @@ int main(int argc, char** argv) {
     s.bodies[b].pos = rt::Vec3(0, 0, spec.rim + 100.0);
     rt::set_body_velocity(m.bodies[b], s.bodies[b], rt::Vec3::Zero(), rt::Vec3::Zero());
     make_dirs(cache + "/beds");
-    const std::string ckpt = cache + "/beds/" + bed_key(m, s) + ".ckpt";
+    const std::string ckpt = cache + "/beds/" + bed_key(m, s, b) + ".ckpt";
     if (std::ifstream(ckpt).good()) {
       s = rt::load_checkpoint(ckpt, m);
       if (!quiet) std::fprintf(stderr, "[landing] relaxed bed from the cache: %s\n", ckpt.c_str());

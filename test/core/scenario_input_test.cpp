@@ -456,3 +456,49 @@ TEST_F(ScenarioInput, CommandLineToolReportsBlowUpWithExitCode3) {
   EXPECT_NO_THROW(JsonReader(summary).document()) << summary;
   EXPECT_EQ(JsonReader(summary).document()["status"].str, "blow_up");
 }
+
+TEST_F(ScenarioInput, CarvedBodyRemovesExactlyTheGrainsItOverlaps) {
+  // A lattice of grains and an ellipsoid boulder buried in it: 'carve' removes
+  // the grains the ellipsoid overlaps and no others.
+  const char* const text = R"(name: carve
+materials:
+  grain: {preset: moderate}
+  rock: {preset: moderate, eps_n: 0.6, eps_t: 0.6, structure: true}
+contact: {model: linear, kn: rule, v_max: 0.19, x_max: 0.01, steps_per_contact: 30}
+bodies:
+  - name: boulder
+    shapes: [{type: ellipsoid, size: [0.15, 0.111, 0.0645]}]
+    mass: 5.0
+    inertia: [0.01648, 0.02666, 0.03482]
+    material: rock
+    position: [0.01, -0.02, 0.12]
+    orientation: {rpy_deg: [0, 0, 30]}
+    carve: true
+grains:
+  - name: bed
+    material: grain
+    radius: 0.01
+    fill: {shape: box, lo: [-0.25, -0.25, 0.0], hi: [0.25, 0.25, 0.3], count: 6000}
+stages:
+  - {name: rest, duration: 0.01}
+)";
+  const std::string plain = replaced(text, "    carve: true\n", "");
+  const rt::Scenario full = rt::load_scenario(write("plain.yaml", plain));
+  const rt::Scenario sc = rt::load_scenario(write("carve.yaml", text));
+  ASSERT_GT(full.model.n_grains, 0);
+  EXPECT_EQ(full.carved_grains, 0);
+  const rt::BodyModel& bm = full.model.bodies[0];
+  const rt::BodyState& bs = full.initial.bodies[0];
+  int inside = 0;
+  for (int i = 0; i < full.model.n_grains; ++i)
+    inside += rt::shape_gap(bm, bm.shapes[0], bs.q.conjugate() * (full.initial.pos[i] - bs.pos),
+                            full.model.grain_radius[i]).overlap > 0;
+  ASSERT_GT(inside, 50) << "the boulder sits inside the lattice";
+  EXPECT_EQ(sc.carved_grains, inside);
+  EXPECT_EQ(sc.model.n_grains, full.model.n_grains - inside);
+  double worst = -1;
+  for (int i = 0; i < sc.model.n_grains; ++i)
+    worst = std::max(worst, rt::shape_gap(bm, bm.shapes[0], bs.q.conjugate() * (sc.initial.pos[i] - bs.pos),
+                                          sc.model.grain_radius[i]).overlap);
+  EXPECT_LE(worst, 0.0) << "no grain left inside the boulder";
+}

@@ -63,6 +63,8 @@ struct Scenario {
   std::vector<std::string> warnings;  // non-fatal remarks (under-resolved contacts, ...)
   double scene_kn = 0, scene_dt = 0;  // k_n and dt as parsed (stages may scale the model's)
   double scene_body_kn = 0;           // contact.body_kn as parsed (0: the scene k_n; stages scale it too)
+  int carved_grains = 0;              // grains removed where bodies with 'carve: true' sit
+  std::vector<int> carve;             // bodies with 'carve: true'
   const GrainGroup* group(const std::string& name) const;
 };
 

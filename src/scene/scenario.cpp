@@ -792,7 +792,21 @@ Scenario parse_scenario_text(const std::string& yaml_text, const std::string& so
   return parse_scenario(root, source);
 }
 
-YAML::Node load_document(const std::string& path, const std::vector<std::string>& overrides) {
+namespace {
+
+// Deep merge for 'base:': mappings merge key by key, anything else (lists,
+// scalars) in `over` replaces what `base` had.
+YAML::Node merged(const YAML::Node& base, const YAML::Node& over) {
+  if (!base.IsMap() || !over.IsMap()) return YAML::Clone(over);
+  YAML::Node out = YAML::Clone(base);
+  for (const auto& kv : over) {
+    const std::string key = kv.first.as<std::string>();
+    out[key] = out[key] ? merged(out[key], kv.second) : YAML::Clone(kv.second);
+  }
+  return out;
+}
+
+YAML::Node read_document(const std::string& path, int depth) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open scenario file");
   YAML::Node root;
@@ -801,21 +815,33 @@ YAML::Node load_document(const std::string& path, const std::vector<std::string>
   } catch (const YAML::Exception& e) {
     throw InputError(path + ": not valid YAML: " + e.what());
   }
+  if (!root.IsMap() || !root["base"]) return root;
+  // 'base: FILE' (relative to this file): start from FILE and change what this file gives.
+  if (!root["base"].IsScalar()) throw InputError(path + ": key 'base': expected a file name");
+  if (depth >= 8) throw InputError(path + ": key 'base': more than 8 nested base files (a cycle?)");
+  std::string file = root["base"].Scalar();
+  const auto slash = path.rfind('/');
+  if (!file.empty() && file[0] != '/' && slash != std::string::npos) file = path.substr(0, slash + 1) + file;
+  YAML::Node base;
+  try {
+    base = read_document(file, depth + 1);
+  } catch (const InputError& e) {
+    throw InputError(path + ": key 'base': " + e.what());
+  }
+  root.remove("base");
+  return merged(base, root);
+}
+
+}  // namespace
+
+YAML::Node load_document(const std::string& path, const std::vector<std::string>& overrides) {
+  YAML::Node root = read_document(path, 0);
   for (const auto& o : overrides) apply_override(root, o);
   return root;
 }
 
 Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open scenario file");
-  YAML::Node root;
-  try {
-    root = YAML::Load(in);
-  } catch (const YAML::Exception& e) {
-    throw InputError(path + ": not valid YAML: " + e.what());
-  }
-  for (const auto& o : overrides) apply_override(root, o);
-  return parse_scenario(root, path);
+  return parse_scenario(load_document(path, overrides), path);
 }
 
 }  // namespace rt

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cctype>
 #include <cmath>
@@ -501,4 +502,45 @@ stages:
     worst = std::max(worst, rt::shape_gap(bm, bm.shapes[0], bs.q.conjugate() * (sc.initial.pos[i] - bs.pos),
                                           sc.model.grain_radius[i]).overlap);
   EXPECT_LE(worst, 0.0) << "no grain left inside the boulder";
+}
+
+TEST_F(ScenarioInput, BaseFileMergesMappingsAndReplacesLists) {
+  write("base.yaml", kBase);
+  const std::string derived = write("derived.yaml", R"(base: base.yaml
+name: derived
+materials:
+  grain: {preset: gravel}
+stages:
+  - {name: longer, duration: 0.5}
+)");
+  const rt::Scenario sc = rt::load_scenario(derived, {"output.every=0.004"});
+  EXPECT_EQ(sc.name, "derived");
+  ASSERT_EQ(sc.stages.size(), 1u);
+  EXPECT_EQ(sc.stages[0].name, "longer") << "a list replaces the base's";
+  EXPECT_DOUBLE_EQ(sc.stages[0].duration, 0.5);
+  EXPECT_EQ(sc.model.n_grains, 1) << "grains come from the base";
+  EXPECT_DOUBLE_EQ(sc.output_every, 0.004) << "--set applies after the merge";
+  rt::Material gravel;
+  ASSERT_TRUE(rt::material_preset("gravel", gravel));
+  EXPECT_DOUBLE_EQ(sc.model.materials[0].mu_s, gravel.mu_s) << "a mapping merges into the base's";
+  EXPECT_DOUBLE_EQ(sc.model.materials[1].eps_n, 0.5) << "untouched base material kept";
+  // A missing base and a cycle are refused, naming the file and the key.
+  expect_refused("nobase.yaml", "base: absent.yaml\nname: x\n", {"base", "absent.yaml"});
+  write("loop_a.yaml", "base: loop_b.yaml\n");
+  write("loop_b.yaml", "base: loop_a.yaml\n");
+  expect_refused("loop_a.yaml", "base: loop_b.yaml\n", {"base", "cycle"});
+}
+
+TEST_F(ScenarioInput, ShippedBoulderAndCliffScenesCarveTheBed) {
+  // config/ is read relative to the source tree (the tests' working folder).
+  for (const char* file : {"config/mascot_boulder.yaml", "config/mascot_cliff.yaml"}) {
+    YAML::Node root = rt::load_document(file);
+    ASSERT_TRUE(root["landing"]) << file;
+    root.remove("landing");
+    const rt::Scenario sc = rt::parse_scenario(root, file);
+    ASSERT_EQ(sc.model.bodies.size(), 2u) << file;
+    EXPECT_EQ(sc.model.bodies[0].name, "mascot") << file;
+    EXPECT_GT(sc.carved_grains, 100) << file;
+    EXPECT_EQ(sc.model.n_grains + sc.carved_grains, 61534) << file << ": the shipped moderate bed";
+  }
 }

@@ -73,7 +73,9 @@ struct Scenario {
 Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides = {});
 
 // Read a YAML document and apply "dotted.key=yaml-value" overrides, for tools
-// that take extra top-level blocks out before parse_scenario.
+// that take extra top-level blocks out before parse_scenario. A top-level
+// `base: FILE` (relative to the document) starts from FILE: mappings merge key
+// by key, lists and scalars given here replace the base's.
 YAML::Node load_document(const std::string& path, const std::vector<std::string>& overrides = {});
 
 // Interpret an already parsed document; `source` names it in error messages.

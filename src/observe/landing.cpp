@@ -95,7 +95,7 @@ LandingSpec parse_landing(const YAML::Node& n, const std::string& src) {
                                          "angle_deg", "heading_deg", "speed", "clearance", "aim", "slope_deg", "g",
                                          "after_liftoff", "max_after_contact", "max_time", "far_ring",
                                          "sphere_radius", "repeat", "perturb_seed", "sample_every",
-                                         "active_radius"};
+                                         "active_radius", "trapped_hold"};
   BlockReader rd{n, src};
   for (const auto& kv : n) {
     const std::string k = kv.first.as<std::string>();
@@ -137,6 +137,7 @@ LandingSpec parse_landing(const YAML::Node& n, const std::string& src) {
   sp.perturb_seed = (unsigned long)rd.num("perturb_seed", 1, 0, 4e9);
   sp.sample_every = rd.num("sample_every", sp.sample_every, 1e-6, 1e3);
   sp.active_radius = rd.num("active_radius", sp.active_radius, 0, 1e3);
+  sp.trapped_hold = rd.num("trapped_hold", sp.trapped_hold, 0, 1e5);
   return sp;
 }
 
@@ -336,6 +337,12 @@ LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& sp, con
   const int check_every = std::max(1, int(std::lround(1e-3 / m.dt)));  // ejecta sampled each millisecond
   double next_sample = s.time;
   const BodyState& bs = s.bodies[b];
+  // Lowest height of the centre of mass above the trim plane at which every
+  // corner can be above it, and the time since the lander became trapped.
+  double liftoff_com = 0;
+  if (const int k = largest_box(bm); k >= 0)
+    liftoff_com = std::max(0.0, bm.shapes[k].size.minCoeff() - bm.shapes[k].pos.norm());
+  double trapped_since = -1;
   auto lowest_corner = [&] {
     double low = 1e300;
     for (const Vec3& c : lander_corners(m, s, b)) low = std::min(low, c.z() - sp.rim);
@@ -413,6 +420,19 @@ LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& sp, con
       if (o.lifted_off && s.time >= o.t_liftoff + sp.after_liftoff) {
         o.ended_by = "after_liftoff";
         break;
+      }
+      if (o.contact && !o.lifted_off && sp.trapped_hold > 0) {
+        const double need = bm.mass * std::max(0.0, -m.gravity.z()) *  // potential energy to lift off
+                            std::max(0.0, sp.rim + liftoff_com - bs.pos.z());
+        if (body_lin_energy(bm, bs) + body_rot_energy(bm, bs) < 0.5 * need) {
+          if (trapped_since < 0) trapped_since = s.time;
+        } else {
+          trapped_since = -1;
+        }
+        if (trapped_since >= 0 && s.time >= trapped_since + sp.trapped_hold) {
+          o.ended_by = "trapped";
+          break;
+        }
       }
       if (o.contact && !o.lifted_off && s.time >= o.t_contact + sp.max_after_contact) {
         o.ended_by = "max_after_contact";

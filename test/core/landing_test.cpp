@@ -191,3 +191,46 @@ TEST(Landing, BounceOnARigidPlateGivesAConsistentOutcome) {
   EXPECT_NEAR(o.second_impact_speed * o.second_impact_speed, o.v_out * o.v_out + 2 * 9.81 * (o.h_liftoff - ht), 1e-9);
   RecordProperty("speed_ratio", rt::test::figure(o.speed_ratio));
 }
+
+TEST(Landing, LanderTrappedBelowTheTrimPlaneEndsTheRunEarly) {
+  // The plate's top 0.25 m below the trim plane: a slow lander that lands on
+  // it can never get every corner back above the trim plane. The run stops
+  // once its kinetic energy has stayed below half the potential energy of a
+  // lift-off for trapped_hold, long before max_after_contact, with V_out = 0;
+  // with trapped_hold = 0 it runs to max_after_contact.
+  const double rim = 0.3;
+  rt::Model m = lander_scene(rim, 0.6);
+  m.gravity = Vec3(0, 0, -9.81);
+  rt::LandingSpec sp;
+  sp.lander = "lander";
+  sp.rim = rim - 0.25;  // the trim plane for placement ...
+  sp.container_radius = 0.4;
+  sp.attitude = rt::Attitude::Flat;
+  sp.angle_deg = 0;
+  sp.speed = 0.05;
+  sp.g = 9.81;
+  sp.max_after_contact = 0.6;
+  sp.trapped_hold = 0.1;
+  rt::LandingOptions opt;
+  opt.progress_every = 0;
+  for (const double hold : {0.1, 0.0}) {
+    rt::State s = layer_state(m, rim);
+    s.bodies[1].pos.z() -= 0.25;  // plate top at the placement plane
+    sp.rim = rim - 0.25;
+    rt::place_lander(m, s, 0, sp);
+    sp.rim = rim;  // ... and the surface reference 0.25 m higher
+    sp.trapped_hold = hold;
+    const rt::LandingOutcome o = rt::run_landing(m, s, 0, sp, opt);
+    ASSERT_EQ(o.status, "ok") << o.message;
+    ASSERT_TRUE(o.contact);
+    EXPECT_FALSE(o.lifted_off);
+    EXPECT_EQ(o.v_out, 0);
+    if (hold > 0) {
+      EXPECT_EQ(o.ended_by, "trapped");
+      EXPECT_LT(o.t_end - o.t_contact, 0.3) << "stopped early";
+    } else {
+      EXPECT_EQ(o.ended_by, "max_after_contact");
+      EXPECT_NEAR(o.t_end - o.t_contact, 0.6, 1e-3);
+    }
+  }
+}

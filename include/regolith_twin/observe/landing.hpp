@@ -33,6 +33,13 @@ struct LandingSpec {
   double after_liftoff = 1.0;    // run end: this long after lift-off, s
   double max_after_contact = 60; // ... or this long after first contact, s
   double max_time = 600;         // safety net: no contact at all within this time, s
+  // A run without lift-off also ends once the lander is trapped: its kinetic
+  // energy (translation + rotation) has stayed below half the potential
+  // energy it needs to lift off for this long (s; 0: never, run to
+  // max_after_contact). Lift-off needs every corner above the trim plane, so
+  // the centre of mass at least (smallest half-extent of the box - offset of
+  // the box from the centre of mass) above it. V_out = 0 either way.
+  double trapped_hold = 1.0;
   double far_ring = 0.05;        // width of the outer ring for the far-field quiet check, m
   double sphere_radius = 0.155;  // volume-equivalent sphere radius for the travel distance, m
   long repeat = 0;               // perturbed bed number (0: the bed as prepared)

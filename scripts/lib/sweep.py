@@ -267,6 +267,7 @@ def collect(out):
                 row[k] = v
                 if k not in outcome_keys:
                     outcome_keys.append(k)
+        row["ended_by"] = oc.get("ended_by")
         bed = summary.get("bed", {})
         row["grains"] = bed.get("grains")
         row["packing_fraction"] = bed.get("packing_fraction")
@@ -278,7 +279,7 @@ def collect(out):
 
 
 def write_aggregate(out, rows, outcome_keys):
-    cols = ["run"] + KEYS + ["status"] + outcome_keys + ["grains", "packing_fraction", "land_wall_seconds",
+    cols = ["run"] + KEYS + ["status", "ended_by"] + outcome_keys + ["grains", "packing_fraction", "land_wall_seconds",
                                                          "wall_seconds"]
     path = os.path.join(out, "aggregate.csv")
     with open(path, "w", newline="") as f:
@@ -397,7 +398,9 @@ def write_report(out, rows, outcome_keys, plots, spread, grid_meta):
     L.append("")
     L.append("Repeat 0 is the bed as prepared; repeats 1, 2, ... are perturbed beds (rotated about the "
              "container axis, aim point shifted within one grain diameter). A run without lift-off counts "
-             "with V_out = 0 (speed ratio and travel distance 0).")
+             "with V_out = 0 (speed ratio and travel distance 0); its collision duration is the time until the "
+             "run ended (end 'trapped': the lander's kinetic energy stayed below half of what a lift-off needs; "
+             "'max_after_contact': the 60 s limit).")
     walls = [r["wall_seconds"] for r in ok if r.get("wall_seconds") is not None]
     if walls:
         s = stats(walls)
@@ -434,14 +437,14 @@ def write_report(out, rows, outcome_keys, plots, spread, grid_meta):
     if rows:
         L += ["", "## Runs", "", "Every number of the summaries is in `aggregate.csv`; per-run plots are in "
               "`runs/<run>/*.png`.", "",
-              "| run | status | speed ratio | E_rot,out/E_lin,in | angle out (deg) | travel (m) | penetration (cm) "
-              "| collision (s) | ejected volume (cm³) | wall |",
-              "|---|---|---|---|---|---|---|---|---|---|"]
+              "| run | status | end | speed ratio | E_rot,out/E_lin,in | angle out (deg) | travel (m) "
+              "| penetration (cm) | collision (s) | ejected volume (cm³) | wall |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in rows:
             def v(k, scale=1.0):
                 x = r.get(k)
                 return "" if x is None else fmt(x * scale)
-            L.append(f"| {r['run']} | {r['status']} | {v('speed_ratio')} | {v('E_rot_out_over_E_lin_in')} | "
+            L.append(f"| {r['run']} | {r['status']} | {r.get('ended_by') or ''} | {v('speed_ratio')} | {v('E_rot_out_over_E_lin_in')} | "
                      f"{v('angle_out_deg')} | {v('travel_distance')} | {v('max_penetration', 100)} | "
                      f"{v('collision_duration')} | {v('ejected_volume', 1e6)} | "
                      f"{fmt_time(r['wall_seconds']) if r.get('wall_seconds') is not None else ''} |")

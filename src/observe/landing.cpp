@@ -370,10 +370,18 @@ LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& sp, con
         o.e_rot_in = body_rot_energy(bm, bs);
       }
       if (o.lifted_off && touching) {
-        // Contact again within the after-lift-off window: the lander had not
-        // left; the collision goes on (decision, documented in landing.hpp).
-        o.lifted_off = false;
-        ++o.relandings;
+        // Contact again within the after-lift-off window with the bed (a body,
+        // or a grain that is not ejecta): the lander had not left; the
+        // collision goes on (decision, documented in landing.hpp). Ejected
+        // grains drifting with the lander do not count.
+        bool bed_contact = s.stats.body_body_contacts > 0;
+        const BodyGrainList& bl = s.body_grains;
+        for (int k = 0; k < bl.size() && !bed_contact; ++k)
+          bed_contact = bl.touching[k] && bl.body[k] == b && s.pos[bl.grain[k]].z() <= sp.rim + mean_r;
+        if (bed_contact) {
+          o.lifted_off = false;
+          ++o.relandings;
+        }
       }
       if (o.contact && !o.lifted_off) {
         o.max_penetration = std::max(o.max_penetration, -low);

@@ -85,9 +85,11 @@ std::vector<Vec3> lander_corners(const Model& m, const State& s, int b);
 struct LandingOutcome {
   bool contact = false;          // the lander touched the bed
   // Lift-off: all eight corners above the trim plane, no contact left and the
-  // centre of mass moving away from the surface. A contact within the
-  // after_liftoff window cancels it (the lander had not left: corners of a
-  // tilted lander can all be above the plane in mid-collision while it turns).
+  // centre of mass moving away from the surface. A contact with the bed
+  // within the after_liftoff window cancels it (the lander had not left:
+  // corners of a tilted lander can all be above the plane in mid-collision
+  // while it turns, on grains that stand above the plane); touches by ejected
+  // grains (centre more than one mean radius above the plane) do not.
   bool lifted_off = false;
   int relandings = 0;            // lift-offs cancelled by a renewed contact
   std::string ended_by;          // after_liftoff | max_after_contact | max_time

@@ -11,6 +11,7 @@ Afterwards (or with --report-only) OUT/aggregate.csv, OUT/*.png and
 OUT/report.md are written from every run in OUT/runs.
 """
 import argparse
+import concurrent.futures
 import csv
 import json
 import math
@@ -20,6 +21,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -110,8 +112,23 @@ def fmt_time(sec):
 # ---------------------------------------------------------------- running
 
 class Child:
-    """The regolith_land process under way, stopped with the sweep."""
-    proc = None
+    """The regolith_land processes under way, stopped with the sweep."""
+    procs = set()
+    lock = threading.Lock()
+    stopping = False
+
+    @staticmethod
+    def stop_all():
+        with Child.lock:
+            procs = list(Child.procs)
+        for p in procs:
+            if p.poll() is None:
+                p.terminate()
+        for p in procs:
+            try:
+                p.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                p.kill()
 
 
 def die_with_parent():
@@ -160,17 +177,22 @@ def run_one(a, land, point, bed, out_runs, index, total, eta_text):
     print(f"[{index}/{total}] start {name}  ({time.strftime('%H:%M:%S')}; ETA {eta_text})", flush=True)
     t0 = time.time()
     with open(os.path.join(tmp, "run.log"), "w") as log:
-        Child.proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, preexec_fn=die_with_parent)
+        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, preexec_fn=die_with_parent)
+        with Child.lock:
+            Child.procs.add(proc)
         try:
-            rc = Child.proc.wait()
+            rc = proc.wait()
         finally:
-            if Child.proc.poll() is None:
-                Child.proc.terminate()
+            if proc.poll() is None:
+                proc.terminate()
                 try:
-                    Child.proc.wait(timeout=10)
+                    proc.wait(timeout=10)
                 except subprocess.TimeoutExpired:
-                    Child.proc.kill()
-            Child.proc = None
+                    proc.kill()
+            with Child.lock:
+                Child.procs.discard(proc)
+        if Child.stopping:
+            raise KeyboardInterrupt("sweep stopped")
     wall = time.time() - t0
     meta["exit_code"] = rc
     meta["wall_seconds"] = round(wall, 3)
@@ -213,29 +235,61 @@ def sweep(a, grid, land):
     done_before = total - len(todo)
     print(f"sweep: {total} runs in {a.out}/runs ({done_before} already done, {len(todo)} to run)", flush=True)
     walls, failed = [], []
-    for k, (i, p) in enumerate(todo):
-        left = len(todo) - k
-        eta_text = fmt_time(sum(walls) / len(walls) * left) if walls else "after the first run"
-        rc, status, wall, summary = run_one(a, land, p, bed_file(a.bed_dir, p[0], p[1]), out_runs, i, total,
-                                            eta_text)
-        walls.append(wall)
-        left -= 1
-        eta = fmt_time(sum(walls) / len(walls) * left) if left else "0 s"
-        name = run_name(*p)
-        if status == "ok":
-            oc = summary.get("outcome", {})
-            what = ("lifted off" if oc.get("lifted_off") else "no lift-off") + \
-                f", speed ratio {oc.get('speed_ratio', 0):.3f}"
-            print(f"[{i}/{total}] done  {name}: {what}; {fmt_time(wall)} wall; ETA {eta}", flush=True)
-        else:
-            failed.append(name)
-            print(f"[{i}/{total}] FAIL  {name}: {status} after {fmt_time(wall)} "
-                  f"(log: {out_runs}/{name}/run.log); ETA {eta}", flush=True)
-            if rc == 2:
-                with open(os.path.join(out_runs, name, "run.log")) as f:
-                    sys.stderr.write(f.read())
-                fail("bad input (exit 2): stopping the sweep")
+    jobs = max(1, min(a.jobs, len(todo)))
+
+    def eta_of(left):
+        # Runs left, spread over the parallel jobs, at the mean wall time so far.
+        return fmt_time(sum(walls) / len(walls) * math.ceil(left / jobs)) if walls else "after the first run"
+
+    def start(k):
+        i, p = todo[k]
+        return pool.submit(run_one, a, land, p, bed_file(a.bed_dir, p[0], p[1]), out_runs, i, total,
+                           eta_of(len(todo) - k))
+
+    pool = concurrent.futures.ThreadPoolExecutor(max_workers=jobs)
+    running = {}
+    try:
+        for k in range(jobs):
+            running[start(k)] = k
+        next_k = jobs
+        while running:
+            finished, _ = concurrent.futures.wait(running, return_when=concurrent.futures.FIRST_COMPLETED)
+            for fut in finished:
+                k = running.pop(fut)
+                i, p = todo[k]
+                rc, status, wall, summary = fut.result()
+                walls.append(wall)
+                left = len(todo) - len(walls)
+                eta = eta_of(left) if left else "0 s"
+                report_run(i, total, p, rc, status, wall, summary, eta, out_runs, failed)
+                if next_k < len(todo):
+                    running[start(next_k)] = next_k
+                    next_k += 1
+    except BaseException:
+        Child.stopping = True
+        Child.stop_all()
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
     return failed
+
+
+def report_run(i, total, p, rc, status, wall, summary, eta, out_runs, failed):
+    """One line per finished run; bad input (exit 2) stops the sweep."""
+    name = run_name(*p)
+    if status == "ok":
+        oc = summary.get("outcome", {})
+        what = ("lifted off" if oc.get("lifted_off") else "no lift-off") + \
+            f", speed ratio {oc.get('speed_ratio', 0):.3f}"
+        print(f"[{i}/{total}] done  {name}: {what}; {fmt_time(wall)} wall; ETA {eta}", flush=True)
+        return
+    failed.append(name)
+    print(f"[{i}/{total}] FAIL  {name}: {status} after {fmt_time(wall)} "
+          f"(log: {out_runs}/{name}/run.log); ETA {eta}", flush=True)
+    if rc == 2:
+        with open(os.path.join(out_runs, name, "run.log")) as f:
+            sys.stderr.write(f.read())
+        fail("bad input (exit 2): stopping the sweep")
 
 
 # ---------------------------------------------------------------- report
@@ -514,6 +568,9 @@ def main(argv=None):
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="extra override for every run (after the sweep's own)")
     ap.add_argument("--threads", type=int, default=0, help="OpenMP threads per run (default: regolith_land's)")
+    ap.add_argument("--jobs", type=int, default=1,
+                    help="runs at the same time (default 1); e.g. --jobs 2 --threads 1 on two cores. Runs on a "
+                         "bed not yet relaxed in the cache each relax it")
     ap.add_argument("--cache", default="", help="relaxed-bed cache folder passed to regolith_land")
     ap.add_argument("--land", default=os.path.join(ROOT, "build", "devel", "lib", "regolith_twin", "regolith_land"),
                     help="regolith_land binary")
@@ -547,6 +604,8 @@ def main(argv=None):
         fail("--repeats: at least 1")
     if a.threads < 0:
         fail("--threads: at least 1")
+    if not 1 <= a.jobs <= 256:
+        fail(f"--jobs {a.jobs}: expected 1 to 256")
     for s in a.set:
         if "=" not in s:
             fail(f"--set '{s}': expected key=value")

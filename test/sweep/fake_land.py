@@ -24,8 +24,11 @@ while i < len(args):
         i += 2
     else:
         i += 1
+started = time.time()
 time.sleep(float(os.environ.get("FAKE_LAND_SLEEP", "0")))
 os.makedirs(out, exist_ok=True)
+with open(os.path.join(out, "stamps.json"), "w") as f:  # when this run was under way
+    json.dump({"start": started, "end": time.time()}, f)
 ang = float(sets.get("landing.angle_deg", 30))
 rep = int(sets.get("landing.repeat", 0))
 rim = float(sets.get("landing.rim", 0.3))

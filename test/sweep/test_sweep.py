@@ -79,6 +79,25 @@ class SweepTest(unittest.TestCase):
             text = f.read()
         self.assertIn("| gravel | 0.3 | Flat | 60 | 2 | 1/2 |", text)
 
+    def test_parallel_jobs(self):
+        # --jobs 3: runs overlap in time, and every run finishes once.
+        cmd = [sys.executable, SWEEP, "--land", FAKE, "--bed-dir", self.beds, "--out", self.out,
+               "--materials", "moderate,gravel", "--angles", "0,30,60", "--jobs", "3", "--no-run-plots"]
+        p = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, FAKE_LAND_SLEEP="1.0"))
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        rows = self.rows()
+        self.assertEqual(len(rows), 6)
+        self.assertTrue(all(r["status"] == "ok" for r in rows))
+        spans = []
+        for r in rows:
+            with open(os.path.join(self.out, "runs", r["run"], "stamps.json")) as f:
+                st = json.load(f)
+            spans.append((st["start"], st["end"]))
+        most = max(sum(1 for s in spans if s[0] <= t < s[1]) for t, _ in spans)
+        self.assertGreaterEqual(most, 2, spans)
+        self.assertLessEqual(most, 3, spans)
+        self.assertEqual(p.stdout.count(" done  "), 6, p.stdout)
+
     def test_missing_bed(self):
         os.remove(os.path.join(self.beds, "mascot_gravel_d30.bed"))
         p = self.sweep()

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Plots of one MASCOT landing run (the output folder of regolith_land).
 
-usage: plot_landing.py RUN_DIR [--rim Z]
+usage: plot_landing.py RUN_DIR [--rim Z] [--map-cell M]
 
 Reads RUN_DIR/summary.json, series.csv and surface.csv and writes into RUN_DIR:
   trajectory.png  centre-of-mass height above the trim plane, horizontal
@@ -17,6 +17,7 @@ import argparse
 import json
 import os
 import sys
+import warnings
 
 import matplotlib
 
@@ -167,18 +168,33 @@ def plot_force(run, s, evs, head):
     plt.close(fig)
 
 
-def plot_surface(run, surf, s, summary, head):
+def plot_surface(run, surf, s, summary, head, map_cell=0.03):
     x, y, h = surf["x"], surf["y"], surf["height"]
     cell = np.min(np.diff(np.unique(x))) if len(np.unique(x)) > 1 else 0.01
     xs = np.round((x - x.min()) / cell).astype(int)
     ys = np.round((y - y.min()) / cell).astype(int)
     grid = np.full((ys.max() + 1, xs.max() + 1), np.nan)
     grid[ys, xs] = h
-    extent = (x.min() - cell / 2, x.max() + cell / 2, y.min() - cell / 2, y.max() + cell / 2)
+    # Cells smaller than a grain show the gaps between grains as deep holes:
+    # the map takes the highest top over blocks of about map_cell instead.
+    k = max(1, int(round(map_cell / cell)))
+    if k > 1:
+        ny, nx = -(-grid.shape[0] // k) * k, -(-grid.shape[1] // k) * k
+        pad = np.full((ny, nx), np.nan)
+        pad[:grid.shape[0], :grid.shape[1]] = grid
+        blocks = pad.reshape(ny // k, k, nx // k, k)
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # blocks without any grain stay empty
+            grid = np.nanmax(blocks, axis=(1, 3))
+        x0, y0 = x.min() - cell / 2, y.min() - cell / 2
+        extent = (x0, x0 + nx * cell, y0, y0 + ny * cell)
+    else:
+        extent = (x.min() - cell / 2, x.max() + cell / 2, y.min() - cell / 2, y.max() + cell / 2)
     fig, ax = plt.subplots(figsize=(7.2, 6))
-    # Colour range: the bulk of the surface, so that a crater or a few ejected
-    # grains high above do not wash out the map.
-    lo, hi = np.nanpercentile(grid, [1, 99])
+    # Colour range: the crater and the rim around it, so that ejected grains
+    # still in flight (high above, a few percent of the cells) do not wash
+    # out the map; they show in the darkest red.
+    lo, hi = np.nanpercentile(grid, [1, 90])
     lim = max(abs(lo), abs(hi), 1e-4)
     cmap = plt.get_cmap("RdBu_r").copy()
     cmap.set_bad("0.8")  # cells without a grain centre
@@ -215,6 +231,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description="Plots of one regolith_land run.")
     ap.add_argument("run", help="output folder of regolith_land")
     ap.add_argument("--rim", type=float, default=None, help="trim plane height (default: from summary.json, else 0.30)")
+    ap.add_argument("--map-cell", type=float, default=0.03,
+                    help="cell of the height map, m: the highest grain top over it (default 0.03, about 1.5 grain diameters)")
     a = ap.parse_args(argv)
     run = a.run
     summary = load_summary(run)
@@ -232,7 +250,7 @@ def main(argv=None):
         print(f"plot_landing: {run}/series.csv missing or empty: no time-series plots", file=sys.stderr)
     surf = read_csv(os.path.join(run, "surface.csv"))
     if surf is not None:
-        plot_surface(run, surf, s, summary, head)
+        plot_surface(run, surf, s, summary, head, a.map_cell)
         written.append("surface.png")
     else:
         print(f"plot_landing: {run}/surface.csv missing or empty: no height map", file=sys.stderr)

@@ -496,7 +496,7 @@ LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& sp, con
   for (int i = 0; i < m.n_grains; ++i) {
     o.active_grains += m.grain_inv_mass[i] != 0;
     const double d = std::hypot(s.pos[i].x() - zone.centre().x(), s.pos[i].y() - zone.centre().y());
-    if (zone.radius() > 0 && m.grain_inv_mass[i] != 0 && d > zone.radius() - sp.far_ring) {
+    if (zone.radius() > 0 && m.grain_inv_mass[i] != 0 && !ejected[i] && d > zone.radius() - sp.far_ring) {
       sum += s.vel[i].squaredNorm();
       ++cnt;
     }

@@ -110,7 +110,8 @@ struct LandingOutcome {
   double ejected_volume = 0;     // volume of grains whose centre ever rose > one mean radius above the plane, m^3
   long ejected_grains = 0;
   double far_field_rms = 0;      // RMS grain speed in the outer ring at the end, m/s
-  double active_edge_rms = 0;    // RMS speed of free grains in the outer far_ring of the active zone at the end, m/s
+  double active_edge_rms = 0;    // RMS speed of free grains in the outer far_ring of the active zone at the end,
+                                 // ejected grains left out (they land anywhere), m/s
   long active_grains = 0;        // grains free at the end (all grains without an active zone)
   double max_overlap_ratio = 0;
   long steps = 0;

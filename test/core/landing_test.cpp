@@ -64,6 +64,19 @@ rt::State layer_state(const rt::Model& m, double rim) {
   return s;
 }
 
+// A flat landing under 1 g on the rigid plate of lander_scene.
+rt::LandingSpec plate_spec(double rim, double angle_deg, double speed) {
+  rt::LandingSpec sp;
+  sp.lander = "lander";
+  sp.rim = rim;
+  sp.container_radius = 0.4;
+  sp.attitude = rt::Attitude::Flat;
+  sp.angle_deg = angle_deg;
+  sp.speed = speed;
+  sp.g = 9.81;
+  return sp;
+}
+
 }  // namespace
 
 TEST(Landing, PlacementFollowsAttitudeAngleAndAim) {
@@ -154,14 +167,7 @@ TEST(Landing, BounceOnARigidPlateGivesAConsistentOutcome) {
   rt::Model m = lander_scene(rim, 0.6);
   m.gravity = Vec3(0, 0, -9.81);
   rt::State s = layer_state(m, rim);
-  rt::LandingSpec sp;
-  sp.lander = "lander";
-  sp.rim = rim;
-  sp.container_radius = 0.4;
-  sp.attitude = rt::Attitude::Flat;
-  sp.angle_deg = 20;
-  sp.speed = 0.5;
-  sp.g = 9.81;
+  rt::LandingSpec sp = plate_spec(rim, 20, 0.5);
   sp.clearance = 0.001;
   sp.after_liftoff = 0.01;
   sp.max_after_contact = 1.0;
@@ -201,16 +207,8 @@ TEST(Landing, LanderTrappedBelowTheTrimPlaneEndsTheRunEarly) {
   const double rim = 0.3;
   rt::Model m = lander_scene(rim, 0.6);
   m.gravity = Vec3(0, 0, -9.81);
-  rt::LandingSpec sp;
-  sp.lander = "lander";
-  sp.rim = rim - 0.25;  // the trim plane for placement ...
-  sp.container_radius = 0.4;
-  sp.attitude = rt::Attitude::Flat;
-  sp.angle_deg = 0;
-  sp.speed = 0.05;
-  sp.g = 9.81;
+  rt::LandingSpec sp = plate_spec(rim, 0, 0.05);
   sp.max_after_contact = 0.6;
-  sp.trapped_hold = 0.1;
   rt::LandingOptions opt;
   opt.progress_every = 0;
   for (const double hold : {0.1, 0.0}) {

@@ -92,7 +92,7 @@ struct LandingOutcome {
   // grains (centre more than one mean radius above the plane) do not.
   bool lifted_off = false;
   int relandings = 0;            // lift-offs cancelled by a renewed contact
-  std::string ended_by;          // after_liftoff | max_after_contact | max_time
+  std::string ended_by;          // after_liftoff | trapped | max_after_contact | max_time
   double t_contact = 0, t_liftoff = 0, t_end = 0;  // s
   double v_in = 0, v_out = 0;    // centre-of-mass speed at first contact and at lift-off, m/s
   double speed_ratio = 0;        // v_out / v_in

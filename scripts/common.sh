@@ -11,7 +11,11 @@ export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
 export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
 
 # Debian packages the build and tests need.
-BUILD_PACKAGES=(g++ make cmake pkg-config catkin libeigen3-dev libyaml-cpp-dev libbullet-dev liburdfdom-dev googletest python3)
+BUILD_PACKAGES=(g++ make cmake pkg-config catkin libeigen3-dev libyaml-cpp-dev libbullet-dev liburdfdom-dev googletest python3
+  # ROS 1 (ROS.md): the node, its messages and its rostests.
+  ros-core-dev libtf2-ros-dev liburdf-dev python3-rostest librostest-dev python3-rosbag librosbag-dev
+  ros-message-generation libgeometry-msgs-dev libsensor-msgs-dev libvisualization-msgs-dev libstd-srvs-dev
+  libdiagnostic-msgs-dev libros-rosgraph-msgs-dev libtf2-msgs-dev python3-roslaunch)
 # Extra packages for reports (plots).
 REPORT_PACKAGES=(python3-numpy python3-matplotlib)
 
@@ -38,7 +42,7 @@ build_all() {
   local jobs
   mkdir -p "$BUILD"
   jobs=$(nproc 2>/dev/null || echo 2)
-  cmake -S "$ROOT" -B "$BUILD" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release >"$BUILD/configure.log" 2>&1 ||
+  cmake -S "$ROOT" -B "$BUILD" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release >"$BUILD/configure.log" 2>&1 ||
     { cat "$BUILD/configure.log" >&2; return 1; }
   echo "regolith_twin: building in $BUILD ..." >&2
   if ! make -C "$BUILD" -j"$jobs" --no-print-directory all tests >"$BUILD/make.log" 2>&1; then

@@ -79,6 +79,16 @@ void finish_kick(const Model& m, State& s, double h) {
 
 namespace rt {
 
+namespace {
+// Contact force and torque of the last pass plus any applied wrench.
+inline Vec3 total_force(const State& s, size_t b) {
+  return s.body_applied_force.empty() ? s.bodies[b].force : Vec3(s.bodies[b].force + s.body_applied_force[b]);
+}
+inline Vec3 total_torque(const State& s, size_t b) {
+  return s.body_applied_torque.empty() ? s.bodies[b].torque : Vec3(s.bodies[b].torque + s.body_applied_torque[b]);
+}
+}  // namespace
+
 // Bodies: the same kick–drift–kick on the centre of mass; the rotation is a
 // kick of the world angular momentum by the torque, then the exact-flow
 // splitting of the free rigid body over dt (free_rotation), then the second
@@ -88,15 +98,16 @@ void kick_drift_bodies(const Model& m, State& s, double h, double dt) {
     const BodyModel& bm = m.bodies[b];
     BodyState& bs = s.bodies[b];
     if (bm.fixed) continue;
-    const Vec3 dv = h * (bs.force / bm.mass + m.gravity);
+    const Vec3 force = total_force(s, b), torque = total_torque(s, b);
+    const Vec3 dv = h * (force / bm.mass + m.gravity);
     bs.vel_mid = bs.vel + dv;
     bs.pos += dt * bs.vel_mid;
-    bs.ang_mom += h * bs.torque;  // L(n+1/2)
+    bs.ang_mom += h * torque;  // L(n+1/2)
     bs.q = free_rotation(bm.inertia, bs.q, bs.ang_mom, dt);
     const Mat3 inv_i = inverse_inertia_world(bm, bs.q);
     bs.omega_mid = inv_i * bs.ang_mom;
-    bs.vel = bs.vel_mid + dv;                        // predicted v(n+1)
-    bs.omega = inv_i * (bs.ang_mom + h * bs.torque);  // predicted omega(n+1)
+    bs.vel = bs.vel_mid + dv;                     // predicted v(n+1)
+    bs.omega = inv_i * (bs.ang_mom + h * torque);  // predicted omega(n+1)
     if (!(bs.vel.squaredNorm() + bs.omega.squaredNorm() < 1e300)) s.stats.finite = false;
   }
 }
@@ -106,8 +117,8 @@ void finish_kick_bodies(const Model& m, State& s, double h) {
     const BodyModel& bm = m.bodies[b];
     BodyState& bs = s.bodies[b];
     if (bm.fixed) continue;
-    bs.vel = bs.vel_mid + h * (bs.force / bm.mass + m.gravity);
-    bs.ang_mom += h * bs.torque;
+    bs.vel = bs.vel_mid + h * (total_force(s, b) / bm.mass + m.gravity);
+    bs.ang_mom += h * total_torque(s, b);
     bs.omega = inverse_inertia_world(bm, bs.q) * bs.ang_mom;
     if (!(bs.vel.squaredNorm() + bs.omega.squaredNorm() < 1e300)) s.stats.finite = false;
   }

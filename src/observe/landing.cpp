@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <random>
 
 #include "regolith_twin/core/energy.hpp"
@@ -225,9 +226,7 @@ void place_lander(const Model& m, State& s, int b, const LandingSpec& sp) {
   s.forces_valid = false;  // the body moved: forces are recomputed by the next step
 }
 
-std::vector<Vec3> lander_corners(const Model& m, const State& s, int b) {
-  const BodyModel& bm = m.bodies[b];
-  const BodyState& bs = s.bodies[b];
+std::vector<Vec3> lander_corners(const BodyModel& bm, const BodyState& bs) {
   std::vector<Vec3> out;
   const int k = largest_box(bm);
   if (k < 0) return out;
@@ -237,6 +236,24 @@ std::vector<Vec3> lander_corners(const Model& m, const State& s, int b) {
     out.push_back(bs.pos + bs.q * (sh.pos + sh.rot * p));
   }
   return out;
+}
+
+std::vector<Vec3> lander_corners(const Model& m, const State& s, int b) { return lander_corners(m.bodies[b], s.bodies[b]); }
+
+BodyContacts body_contacts(const State& s, int b, double bed_top) {
+  BodyContacts c;
+  const BodyGrainList& bl = s.body_grains;
+  for (int k = 0; k < bl.size(); ++k)
+    if (bl.touching[k] && bl.body[k] == b) {
+      ++c.total;
+      c.bed += s.pos[bl.grain[k]].z() <= bed_top;
+    }
+  for (const BodyPointContact& p : s.body_points)
+    if (p.a == b || p.b == b) {
+      ++c.total;
+      ++c.bed;
+    }
+  return c;
 }
 
 void write_surface(const std::string& path, const Model& m, const State& s, const LandingSpec& sp, double cell) {
@@ -260,11 +277,115 @@ void write_surface(const std::string& path, const Model& m, const State& s, cons
     }
 }
 
-namespace {
+
+LandingTracker::LandingTracker(const BodyModel& bm, const LandingSpec& sp, const Vec3& gravity, double t_start)
+    : bm_(bm), sp_(sp), g_(gravity), t_start_(t_start) {
+  if (const int k = largest_box(bm); k >= 0)
+    liftoff_com_ = std::max(0.0, bm.shapes[k].size.minCoeff() - bm.shapes[k].pos.norm());
+}
+
+double LandingTracker::lowest_corner(const BodyState& bs) const {
+  double low = 1e300;
+  for (const Vec3& c : lander_corners(bm_, bs)) low = std::min(low, c.z() - sp_.rim);
+  return low;
+}
+
+const char* LandingTracker::phase() const {
+  return !o_.contact ? "approach" : (!o_.lifted_off ? "collision" : "flight");
+}
+
+bool LandingTracker::update(double t, const BodyState& bs, const BodyContacts& c) {
+  if (ended()) return true;
+  const bool touching = c.total > 0;
+  const double low = lowest_corner(bs);
+  if (!o_.contact && touching) {
+    o_.contact = true;
+    o_.t_contact = t;
+    o_.v_in = bs.vel.norm();
+    o_.e_lin_in = body_lin_energy(bm_, bs);
+    o_.e_rot_in = body_rot_energy(bm_, bs);
+  }
+  if (o_.lifted_off && c.bed > 0) {
+    // Contact again within the after-lift-off window with the bed (a body,
+    // or a grain that is not ejecta): the lander had not left; the collision
+    // goes on (decision, documented in landing.hpp). Ejected grains drifting
+    // with the lander do not count.
+    o_.lifted_off = false;
+    ++o_.relandings;
+  }
+  if (o_.contact && !o_.lifted_off) {
+    o_.max_penetration = std::max(o_.max_penetration, -low);
+    // Lift-off: every corner above the trim plane, no contact, and the
+    // centre of mass moving away from the surface.
+    if (low > 0 && !touching && bs.vel.z() > 0) {
+      o_.lifted_off = true;
+      o_.t_liftoff = t;
+      o_.v_out = bs.vel.norm();
+      o_.e_lin_out = body_lin_energy(bm_, bs);
+      o_.e_rot_out = body_rot_energy(bm_, bs);
+      o_.spin_out = bs.omega.norm();
+      o_.angle_out_deg = std::acos(std::clamp(bs.vel.z() / std::max(o_.v_out, 1e-300), -1.0, 1.0)) / kDeg;
+      o_.h_liftoff = bs.pos.z() - sp_.rim;
+      // Ballistic flight under the (possibly tilted) gravity, heights normal to the trim plane.
+      const Vec3 v0 = bs.vel;
+      const double gn = g_.z(), vn = v0.z();
+      double ht = std::max(o_.h_liftoff, sp_.sphere_radius);
+      double disc = vn * vn + 2 * gn * (ht - o_.h_liftoff);
+      if (disc < 0) {  // apex below the sphere radius: back to the lift-off height instead
+        ht = o_.h_liftoff;
+        disc = vn * vn;
+      }
+      if (gn < 0) {
+        const double tf = (-vn - std::sqrt(disc)) / gn;
+        const Vec3 d = v0 * tf + 0.5 * g_ * tf * tf;
+        o_.travel_time = tf;
+        o_.travel_distance = std::hypot(d.x(), d.y());
+        const Vec3 v1 = v0 + g_ * tf;
+        o_.second_impact_speed = v1.norm();
+        o_.second_impact_angle_deg = std::acos(std::min(1.0, std::fabs(v1.z()) / v1.norm())) / kDeg;
+      }
+    }
+  }
+  if (o_.lifted_off && t >= o_.t_liftoff + sp_.after_liftoff) {
+    o_.ended_by = "after_liftoff";
+  } else if (o_.contact && !o_.lifted_off && sp_.trapped_hold > 0 && trapped(t, bs)) {
+    o_.ended_by = "trapped";
+  } else if (o_.contact && !o_.lifted_off && t >= o_.t_contact + sp_.max_after_contact) {
+    o_.ended_by = "max_after_contact";
+  } else if (!o_.contact && t - t_start_ >= sp_.max_time) {
+    o_.ended_by = "max_time";
+  }
+  return ended();
+}
+
+bool LandingTracker::trapped(double t, const BodyState& bs) {
+  const double need = bm_.mass * std::max(0.0, -g_.z()) *  // potential energy to lift off
+                      std::max(0.0, sp_.rim + liftoff_com_ - bs.pos.z());
+  if (body_lin_energy(bm_, bs) + body_rot_energy(bm_, bs) < 0.5 * need) {
+    if (trapped_since_ < 0) trapped_since_ = t;
+  } else {
+    trapped_since_ = -1;
+  }
+  return trapped_since_ >= 0 && t >= trapped_since_ + sp_.trapped_hold;
+}
+
+void LandingTracker::finish(double t) {
+  if (!o_.lifted_off) o_.v_out = 0;
+  o_.t_end = t;
+  if (o_.contact) {
+    o_.speed_ratio = o_.v_in > 0 ? o_.v_out / o_.v_in : 0;
+    o_.collision_duration = (o_.lifted_off ? o_.t_liftoff : t) - o_.t_contact;
+    if (o_.e_lin_in > 0) {
+      o_.rot_out_over_lin_in = o_.e_rot_out / o_.e_lin_in;
+      o_.energy_ratio = (o_.e_lin_out + o_.e_rot_out) / (o_.e_lin_in + o_.e_rot_in);
+    }
+    if (o_.e_lin_out > 0) o_.rot_out_over_lin_out = o_.e_rot_out / o_.e_lin_out;
+  }
+}
 
 // Active zone: freeze grains (infinite mass, at rest) beyond the radius from
 // the lander's vertical axis, wake those it reaches; woken grains stay free.
-class ActiveZone {
+class LandingObserver::ActiveZone {
  public:
   ActiveZone(Model& m, double radius) : m_(m), radius_(radius) {
     inv_mass_ = m.grain_inv_mass;
@@ -310,11 +431,75 @@ class ActiveZone {
   Vec3 last_ = Vec3::Zero();
 };
 
-}  // namespace
+LandingObserver::LandingObserver(Model& m, State& s, int b, const LandingSpec& sp)
+    : m_(m), s_(s), b_(b), sp_(sp), tracker_(m.bodies[b], sp, m.gravity, s.time) {
+  for (int i = 0; i < m.n_grains; ++i) mean_r_ += m.grain_radius[i];
+  mean_r_ = m.n_grains ? mean_r_ / m.n_grains : 0;
+  ejected_.assign(m.n_grains, 0);
+  above0_.assign(m.n_grains, 0);
+  for (int i = 0; i < m.n_grains; ++i) above0_[i] = s.pos[i].z() > sp.rim + mean_r_;  // not counted
+  zone_ = std::make_unique<ActiveZone>(m, sp.active_radius);
+  zone_->update(s, s.bodies[b].pos, true);
+  if (!s.forces_valid || s.rebuild_requested) prime(m, s);
+  check_every_ = std::max(1, int(std::lround(1e-3 / m.dt)));  // ejecta sampled each millisecond
+}
+
+LandingObserver::~LandingObserver() = default;
+
+BodyContacts LandingObserver::contacts() const { return body_contacts(s_, b_, sp_.rim + mean_r_); }
+
+bool LandingObserver::observe() {
+  const BodyState& bs = s_.bodies[b_];
+  extra_.max_overlap_ratio = std::max(extra_.max_overlap_ratio, s_.stats.max_overlap_ratio);
+  const bool ended = tracker_.update(s_.time, bs, contacts());
+  if (s_.step % check_every_ == 0) {
+    zone_->update(s_, bs.pos, false);
+    for (int i = 0; i < m_.n_grains; ++i)
+      if (!ejected_[i] && !above0_[i] && s_.pos[i].z() > sp_.rim + mean_r_) {
+        ejected_[i] = 1;
+        ++extra_.ejected_grains;
+        extra_.ejected_volume += 4.0 / 3.0 * M_PI * std::pow(m_.grain_radius[i], 3);
+      }
+  }
+  return ended;
+}
+
+LandingOutcome LandingObserver::outcome() const {
+  LandingOutcome o = tracker_.outcome();
+  o.ejected_grains = extra_.ejected_grains;
+  o.ejected_volume = extra_.ejected_volume;
+  o.max_overlap_ratio = extra_.max_overlap_ratio;
+  return o;
+}
+
+LandingOutcome LandingObserver::finish() {
+  tracker_.finish(s_.time);
+  LandingOutcome o = outcome();
+  // Far-field quiet check: RMS grain speed in the outermost ring.
+  double sum = 0;
+  long cnt = 0;
+  for (int i = 0; i < m_.n_grains; ++i)
+    if (std::hypot(s_.pos[i].x(), s_.pos[i].y()) > sp_.container_radius - sp_.far_ring) {
+      sum += s_.vel[i].squaredNorm();
+      ++cnt;
+    }
+  o.far_field_rms = cnt ? std::sqrt(sum / cnt) : 0;
+  sum = 0;
+  cnt = 0;
+  for (int i = 0; i < m_.n_grains; ++i) {
+    o.active_grains += m_.grain_inv_mass[i] != 0;
+    const double d = std::hypot(s_.pos[i].x() - zone_->centre().x(), s_.pos[i].y() - zone_->centre().y());
+    if (zone_->radius() > 0 && m_.grain_inv_mass[i] != 0 && !ejected_[i] && d > zone_->radius() - sp_.far_ring) {
+      sum += s_.vel[i].squaredNorm();
+      ++cnt;
+    }
+  }
+  o.active_edge_rms = cnt ? std::sqrt(sum / cnt) : 0;
+  return o;
+}
 
 LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& sp, const LandingOptions& opt) {
   using Clock = std::chrono::steady_clock;
-  LandingOutcome o;
   const BodyModel& bm = m.bodies[b];
   const auto t0 = Clock::now();
   auto last_progress = t0;
@@ -326,190 +511,52 @@ LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& sp, con
     series.open(opt.out_dir + "/series.csv",
                 {"t", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz", "lowest_corner", "grain_contacts",
                  "body_contacts", "fx", "fy", "fz", "E_lin", "E_rot", "max_overlap_ratio", "ejected_grains"});
-  double mean_r = 0;
-  for (int i = 0; i < m.n_grains; ++i) mean_r += m.grain_radius[i];
-  mean_r = m.n_grains ? mean_r / m.n_grains : 0;
-  std::vector<uint8_t> ejected(m.n_grains, 0), above0(m.n_grains, 0);
-  for (int i = 0; i < m.n_grains; ++i) above0[i] = s.pos[i].z() > sp.rim + mean_r;  // not counted
-  ActiveZone zone(m, sp.active_radius);
-  zone.update(s, s.bodies[b].pos, true);
-  if (!s.forces_valid || s.rebuild_requested) prime(m, s);
-  const int check_every = std::max(1, int(std::lround(1e-3 / m.dt)));  // ejecta sampled each millisecond
+  LandingObserver obs(m, s, b, sp);
   double next_sample = s.time;
   const BodyState& bs = s.bodies[b];
-  // Lowest height of the centre of mass above the trim plane at which every
-  // corner can be above it, and the time since the lander became trapped.
-  double liftoff_com = 0;
-  if (const int k = largest_box(bm); k >= 0)
-    liftoff_com = std::max(0.0, bm.shapes[k].size.minCoeff() - bm.shapes[k].pos.norm());
-  double trapped_since = -1;
-  auto lowest_corner = [&] {
-    double low = 1e300;
-    for (const Vec3& c : lander_corners(m, s, b)) low = std::min(low, c.z() - sp.rim);
-    return low;
+  auto sample = [&] {
+    series.row({s.time, bs.pos.x(), bs.pos.y(), bs.pos.z(), bs.vel.x(), bs.vel.y(), bs.vel.z(), bs.omega.x(),
+                bs.omega.y(), bs.omega.z(), obs.tracker().lowest_corner(bs), double(s.stats.body_contacts),
+                double(s.stats.body_body_contacts), bs.force.x(), bs.force.y(), bs.force.z(),
+                body_lin_energy(bm, bs), body_rot_energy(bm, bs), s.stats.max_overlap_ratio,
+                double(obs.outcome().ejected_grains)});
   };
+  std::string status = "ok", message;
   try {
     for (;;) {
       if (write && s.time >= next_sample - 0.5 * m.dt) {
         next_sample += sp.sample_every;
-        series.row({s.time, bs.pos.x(), bs.pos.y(), bs.pos.z(), bs.vel.x(), bs.vel.y(), bs.vel.z(), bs.omega.x(),
-                    bs.omega.y(), bs.omega.z(), lowest_corner(), double(s.stats.body_contacts),
-                    double(s.stats.body_body_contacts), bs.force.x(), bs.force.y(), bs.force.z(),
-                    body_lin_energy(bm, bs), body_rot_energy(bm, bs), s.stats.max_overlap_ratio,
-                    double(o.ejected_grains)});
+        sample();
       }
       step(m, s);
-      o.max_overlap_ratio = std::max(o.max_overlap_ratio, s.stats.max_overlap_ratio);
-      const bool touching = s.stats.body_contacts > 0 || s.stats.body_body_contacts > 0;
-      const double low = lowest_corner();
-      if (!o.contact && touching) {
-        o.contact = true;
-        o.t_contact = s.time;
-        o.v_in = bs.vel.norm();
-        o.e_lin_in = body_lin_energy(bm, bs);
-        o.e_rot_in = body_rot_energy(bm, bs);
-      }
-      if (o.lifted_off && touching) {
-        // Contact again within the after-lift-off window with the bed (a body,
-        // or a grain that is not ejecta): the lander had not left; the
-        // collision goes on (decision, documented in landing.hpp). Ejected
-        // grains drifting with the lander do not count.
-        bool bed_contact = s.stats.body_body_contacts > 0;
-        const BodyGrainList& bl = s.body_grains;
-        for (int k = 0; k < bl.size() && !bed_contact; ++k)
-          bed_contact = bl.touching[k] && bl.body[k] == b && s.pos[bl.grain[k]].z() <= sp.rim + mean_r;
-        if (bed_contact) {
-          o.lifted_off = false;
-          ++o.relandings;
-        }
-      }
-      if (o.contact && !o.lifted_off) {
-        o.max_penetration = std::max(o.max_penetration, -low);
-        // Lift-off: every corner above the trim plane, no contact, and the
-        // centre of mass moving away from the surface.
-        const bool up = low > 0 && !touching && bs.vel.z() > 0;
-        if (up) {
-          o.lifted_off = true;
-          o.t_liftoff = s.time;
-          o.v_out = bs.vel.norm();
-          o.e_lin_out = body_lin_energy(bm, bs);
-          o.e_rot_out = body_rot_energy(bm, bs);
-          o.spin_out = bs.omega.norm();
-          o.angle_out_deg = std::acos(std::clamp(bs.vel.z() / std::max(o.v_out, 1e-300), -1.0, 1.0)) / kDeg;
-          o.h_liftoff = bs.pos.z() - sp.rim;
-          // Ballistic flight under the (possibly tilted) gravity, heights normal to the trim plane.
-          const Vec3 g = m.gravity, v0 = bs.vel;
-          const double gn = g.z(), vn = v0.z();
-          double ht = std::max(o.h_liftoff, sp.sphere_radius);
-          double disc = vn * vn + 2 * gn * (ht - o.h_liftoff);
-          if (disc < 0) {  // apex below the sphere radius: back to the lift-off height instead
-            ht = o.h_liftoff;
-            disc = vn * vn;
-          }
-          if (gn < 0) {
-            const double t = (-vn - std::sqrt(disc)) / gn;
-            const Vec3 d = v0 * t + 0.5 * g * t * t;
-            o.travel_time = t;
-            o.travel_distance = std::hypot(d.x(), d.y());
-            const Vec3 v1 = v0 + g * t;
-            o.second_impact_speed = v1.norm();
-            o.second_impact_angle_deg = std::acos(std::min(1.0, std::fabs(v1.z()) / v1.norm())) / kDeg;
-          }
-        }
-      }
-      if (s.step % check_every == 0) zone.update(s, bs.pos, false);
-      if (s.step % check_every == 0)
-        for (int i = 0; i < m.n_grains; ++i)
-          if (!ejected[i] && !above0[i] && s.pos[i].z() > sp.rim + mean_r) {
-            ejected[i] = 1;
-            ++o.ejected_grains;
-            o.ejected_volume += 4.0 / 3.0 * M_PI * std::pow(m.grain_radius[i], 3);
-          }
-      if (o.lifted_off && s.time >= o.t_liftoff + sp.after_liftoff) {
-        o.ended_by = "after_liftoff";
-        break;
-      }
-      if (o.contact && !o.lifted_off && sp.trapped_hold > 0) {
-        const double need = bm.mass * std::max(0.0, -m.gravity.z()) *  // potential energy to lift off
-                            std::max(0.0, sp.rim + liftoff_com - bs.pos.z());
-        if (body_lin_energy(bm, bs) + body_rot_energy(bm, bs) < 0.5 * need) {
-          if (trapped_since < 0) trapped_since = s.time;
-        } else {
-          trapped_since = -1;
-        }
-        if (trapped_since >= 0 && s.time >= trapped_since + sp.trapped_hold) {
-          o.ended_by = "trapped";
-          break;
-        }
-      }
-      if (o.contact && !o.lifted_off && s.time >= o.t_contact + sp.max_after_contact) {
-        o.ended_by = "max_after_contact";
-        break;
-      }
-      if (!o.contact && s.time - t_start >= sp.max_time) {
-        o.ended_by = "max_time";
-        break;
-      }
+      if (obs.observe()) break;
       if (opt.progress_every > 0) {
         const auto now = Clock::now();
         if (std::chrono::duration<double>(now - last_progress).count() >= opt.progress_every) {
           last_progress = now;
+          const LandingOutcome& o = obs.tracker().outcome();
           const double wall = std::chrono::duration<double>(now - t0).count();
-          const char* phase = !o.contact ? "approach" : (!o.lifted_off ? "collision" : "after lift-off");
           double left = !o.contact ? 0 : (!o.lifted_off ? o.t_contact + sp.max_after_contact : o.t_liftoff + sp.after_liftoff) - s.time;
           const double rate = (s.time - t_start) / std::max(wall, 1e-9);
           std::fprintf(stderr,
                        "[landing] %s  t = %.4g s  speed %.4g m/s  lowest corner %+.4f m  %d grain contacts  %.3g steps/s  "
                        "%s%.0f s\n",
-                       phase, s.time, bs.vel.norm(), low, int(s.stats.body_contacts),
-                       double(s.step - step0) / std::max(wall, 1e-9), !o.contact ? "" : "at most ",
-                       left / std::max(rate, 1e-300));
+                       obs.tracker().phase(), s.time, bs.vel.norm(), obs.tracker().lowest_corner(bs),
+                       int(s.stats.body_contacts), double(s.step - step0) / std::max(wall, 1e-9),
+                       !o.contact ? "" : "at most ", left / std::max(rate, 1e-300));
         }
       }
     }
   } catch (const BlowUpError& e) {
-    o.status = "blow_up";
-    o.message = e.what();
+    status = "blow_up";
+    message = e.what();
   }
-  if (!o.lifted_off) o.v_out = 0;
-  o.t_end = s.time;
-  if (o.contact) {
-    o.speed_ratio = o.v_in > 0 ? o.v_out / o.v_in : 0;
-    o.collision_duration = (o.lifted_off ? o.t_liftoff : s.time) - o.t_contact;
-    if (o.e_lin_in > 0) {
-      o.rot_out_over_lin_in = o.e_rot_out / o.e_lin_in;
-      o.energy_ratio = (o.e_lin_out + o.e_rot_out) / (o.e_lin_in + o.e_rot_in);
-    }
-    if (o.e_lin_out > 0) o.rot_out_over_lin_out = o.e_rot_out / o.e_lin_out;
-  }
-  // Far-field quiet check: RMS grain speed in the outermost ring.
-  double sum = 0;
-  long cnt = 0;
-  for (int i = 0; i < m.n_grains; ++i)
-    if (std::hypot(s.pos[i].x(), s.pos[i].y()) > sp.container_radius - sp.far_ring) {
-      sum += s.vel[i].squaredNorm();
-      ++cnt;
-    }
-  o.far_field_rms = cnt ? std::sqrt(sum / cnt) : 0;
-  sum = 0;
-  cnt = 0;
-  for (int i = 0; i < m.n_grains; ++i) {
-    o.active_grains += m.grain_inv_mass[i] != 0;
-    const double d = std::hypot(s.pos[i].x() - zone.centre().x(), s.pos[i].y() - zone.centre().y());
-    if (zone.radius() > 0 && m.grain_inv_mass[i] != 0 && !ejected[i] && d > zone.radius() - sp.far_ring) {
-      sum += s.vel[i].squaredNorm();
-      ++cnt;
-    }
-  }
-  o.active_edge_rms = cnt ? std::sqrt(sum / cnt) : 0;
+  LandingOutcome o = obs.finish();
+  o.status = status;
+  o.message = message;
   o.steps = s.step - step0;
   o.wall_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  if (write && o.status == "ok")
-    series.row({s.time, bs.pos.x(), bs.pos.y(), bs.pos.z(), bs.vel.x(), bs.vel.y(), bs.vel.z(), bs.omega.x(),
-                bs.omega.y(), bs.omega.z(), lowest_corner(), double(s.stats.body_contacts),
-                double(s.stats.body_body_contacts), bs.force.x(), bs.force.y(), bs.force.z(),
-                body_lin_energy(bm, bs), body_rot_energy(bm, bs), s.stats.max_overlap_ratio,
-                double(o.ejected_grains)});
+  if (write && o.status == "ok") sample();
   return o;
 }
 

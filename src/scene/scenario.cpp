@@ -465,6 +465,7 @@ void parse_body(const Reader& rd, Scenario& sc, const YAML::Node& n, const std::
       rd.fail(Reader::join(path, "urdf"), e.what());
     }
     b.fixed = rd.boolean(n, path, "fixed", false);
+    b.urdf_file = file;
   } else {
     const YAML::Node shapes = n["shapes"];
     if (!shapes.IsSequence() || shapes.size() == 0) rd.fail(Reader::join(path, "shapes"), "expected a non-empty list");

@@ -61,6 +61,7 @@ struct BodyModel {
   std::vector<TriangleMesh> meshes;
   std::vector<BodyFrame> frames;  // fixed child frames (reference frame first)
   std::string ref_frame;          // name of the reference frame (URDF base link)
+  std::string urdf_file;          // the URDF it was read from ("" for shapes given in a scenario)
   double bound_radius = 0;      // largest distance of a shape point from the centre of mass, m (set by finalize_body)
   double inv_mass() const { return fixed ? 0.0 : 1.0 / mass; }
 };

@@ -114,6 +114,10 @@ struct State {
   std::vector<Vec3> torque;     // total torque of the last force pass, N m
 
   std::vector<BodyState> bodies;  // rigid bodies (n_bodies)
+  // External wrench on each body's centre of mass, world frame (operator
+  // input: thrusters, a mobility arm, a what-if push). Empty: none. An input,
+  // not state: checkpoints do not hold it.
+  std::vector<Vec3> body_applied_force, body_applied_torque;  // N, N m (n_bodies or empty)
 
   std::vector<uint8_t> wall_on;  // 1 while wall w takes part (a lifted cylinder is 0) (n_walls)
 

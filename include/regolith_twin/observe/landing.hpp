@@ -3,6 +3,7 @@
 // definitions (trim plane, run end, ballistic extrapolation, corners).
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,16 @@ void place_lander(const Model& m, State& s, int b, const LandingSpec& spec);
 
 // World positions of the eight corners of the lander's largest box shape.
 std::vector<Vec3> lander_corners(const Model& m, const State& s, int b);
+std::vector<Vec3> lander_corners(const BodyModel& bm, const BodyState& bs);
+
+// Contacts of body b in the current state: every grain and body contact
+// point, and those with the bed (a body, or a grain whose centre is at most
+// bed_top high).
+struct BodyContacts {
+  long total = 0;
+  long bed = 0;
+};
+BodyContacts body_contacts(const State& s, int b, double bed_top);
 
 struct LandingOutcome {
   bool contact = false;          // the lander touched the bed
@@ -118,6 +129,65 @@ struct LandingOutcome {
   double wall_seconds = 0;
   std::string status = "ok";     // ok | blow_up
   std::string message;
+};
+
+// The part of the outcome that follows from the lander's own state: first
+// contact, lift-off, ratios, penetration, ballistic travel and the run end.
+// Fed the lander's state and contacts after every step, it needs nothing
+// else, so a recorded run (body states with contact counts) gives the same
+// numbers when fed again (regolith_bag_outcome).
+class LandingTracker {
+ public:
+  LandingTracker(const BodyModel& bm, const LandingSpec& sp, const Vec3& gravity, double t_start = 0);
+  // After a step at time t. Returns true once the run has ended (ended_by set).
+  bool update(double t, const BodyState& bs, const BodyContacts& c);
+  // Ratios and durations at the end of the run (time t).
+  void finish(double t);
+  bool ended() const { return !o_.ended_by.empty(); }
+  const LandingOutcome& outcome() const { return o_; }
+  const char* phase() const;  // approach | collision | flight
+  double lowest_corner(const BodyState& bs) const;  // lowest corner above the trim plane, m
+
+ private:
+  bool trapped(double t, const BodyState& bs);
+  BodyModel bm_;
+  LandingSpec sp_;
+  Vec3 g_;
+  double t_start_ = 0;
+  double liftoff_com_ = 0;      // lowest centre-of-mass height above the plane with every corner above it
+  double trapped_since_ = -1;
+  LandingOutcome o_;
+};
+
+// The whole landing outcome, step by step: the tracker, ejecta, the active
+// zone (which changes the model: grains frozen and woken) and, at the end,
+// the far-field and zone-edge checks. Used by run_landing and the ROS node.
+class LandingObserver {
+ public:
+  // Primes the state's forces if needed. m and s must outlive the observer.
+  LandingObserver(Model& m, State& s, int b, const LandingSpec& sp);
+  ~LandingObserver();
+  // After every step; returns true once the run has ended.
+  bool observe();
+  // The outcome so far, and the final one (ratios, far-field checks).
+  LandingOutcome outcome() const;
+  LandingOutcome finish();
+  BodyContacts contacts() const;  // of the lander, with the bed top of this scene
+  double bed_top() const { return sp_.rim + mean_r_; }
+  const LandingTracker& tracker() const { return tracker_; }
+
+ private:
+  class ActiveZone;
+  Model& m_;
+  State& s_;
+  int b_;
+  LandingSpec sp_;
+  LandingTracker tracker_;
+  std::unique_ptr<ActiveZone> zone_;
+  double mean_r_ = 0;
+  int check_every_ = 1;
+  std::vector<uint8_t> ejected_, above0_;
+  LandingOutcome extra_;  // ejecta and overlap figures
 };
 
 struct LandingOptions {

@@ -1,0 +1,898 @@
+// The ROS adapter over rt::Twin (see twin_node.hpp and docs/ros.md).
+#include "regolith_twin/ros/twin_node.hpp"
+
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <rosgraph_msgs/Clock.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "regolith_twin/BodyStates.h"
+#include "regolith_twin/Contacts.h"
+#include "regolith_twin/LandingOutcome.h"
+#include "regolith_twin/Status.h"
+#include "regolith_twin/core/energy.hpp"
+#include "regolith_twin/observe/landing_scene.hpp"
+
+namespace rt_ros {
+namespace {
+
+using rt::Quat;
+using rt::Vec3;
+
+geometry_msgs::Point to_point(const Vec3& v) {
+  geometry_msgs::Point p;
+  p.x = v.x();
+  p.y = v.y();
+  p.z = v.z();
+  return p;
+}
+geometry_msgs::Vector3 to_vector(const Vec3& v) {
+  geometry_msgs::Vector3 p;
+  p.x = v.x();
+  p.y = v.y();
+  p.z = v.z();
+  return p;
+}
+geometry_msgs::Quaternion to_quat(const Quat& q) {
+  geometry_msgs::Quaternion m;
+  m.w = q.w();
+  m.x = q.x();
+  m.y = q.y();
+  m.z = q.z();
+  return m;
+}
+Vec3 from_vector(const geometry_msgs::Vector3& v) { return Vec3(v.x, v.y, v.z); }
+
+ros::Time stamp(double t) { return ros::Time(std::max(0.0, t)); }
+
+std::string frame_of(const rt::BodyModel& b, const std::string& link) {
+  return b.name + "/" + (link.empty() ? std::string("base") : link);
+}
+
+double param_number(const ros::NodeHandle& pnh, const std::string& name, double def, double lo, double hi) {
+  if (!pnh.hasParam(name)) return def;
+  double v = 0;
+  int iv = 0;
+  if (!pnh.getParam(name, v)) {
+    if (!pnh.getParam(name, iv))
+      throw std::invalid_argument("parameter ~" + name + ": expected a number in [" + std::to_string(lo) + ", " +
+                                  std::to_string(hi) + "]");
+    v = iv;
+  }
+  if (!(v >= lo && v <= hi))
+    throw std::invalid_argument("parameter ~" + name + " = " + std::to_string(v) + ": allowed range [" +
+                                std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  return v;
+}
+
+bool param_bool(const ros::NodeHandle& pnh, const std::string& name, bool def) {
+  if (!pnh.hasParam(name)) return def;
+  bool v = def;
+  if (!pnh.getParam(name, v)) throw std::invalid_argument("parameter ~" + name + ": expected true or false");
+  return v;
+}
+
+std::string param_text(const ros::NodeHandle& pnh, const std::string& name, const std::string& def) {
+  if (!pnh.hasParam(name)) return def;
+  std::string v;
+  if (!pnh.getParam(name, v)) throw std::invalid_argument("parameter ~" + name + ": expected a string");
+  return v;
+}
+
+}  // namespace
+
+NodeParams read_params(const ros::NodeHandle& pnh) {
+  NodeParams p;
+  p.scenario_file = param_text(pnh, "scenario_file", "");
+  if (p.scenario_file.empty())
+    throw std::invalid_argument("parameter ~scenario_file is missing: give the scenario or landing YAML file");
+  if (!std::ifstream(p.scenario_file).good())
+    throw std::invalid_argument("parameter ~scenario_file: cannot read '" + p.scenario_file + "'");
+  if (pnh.hasParam("set")) {
+    XmlRpc::XmlRpcValue v;
+    pnh.getParam("set", v);
+    if (v.getType() == XmlRpc::XmlRpcValue::TypeString) {
+      const std::string s = v;
+      if (!s.empty()) p.overrides.push_back(s);
+    } else if (v.getType() == XmlRpc::XmlRpcValue::TypeArray) {
+      for (int i = 0; i < v.size(); ++i) {
+        if (v[i].getType() != XmlRpc::XmlRpcValue::TypeString)
+          throw std::invalid_argument("parameter ~set: expected a list of \"dotted.key=value\" strings");
+        p.overrides.push_back(static_cast<std::string>(v[i]));
+      }
+    } else {
+      throw std::invalid_argument("parameter ~set: expected a list of \"dotted.key=value\" strings");
+    }
+  }
+  p.realtime_factor = param_number(pnh, "realtime_factor", 0, -1e9, 1e9);
+  p.clock_rate = param_number(pnh, "clock_rate", 100, 1e-3, 1e6);
+  p.status_rate = param_number(pnh, "status_rate", 10, 1e-3, 1e3);
+  p.body_state_rate = param_number(pnh, "body_state_rate", 0, 0, 1e9);
+  p.contacts_rate = param_number(pnh, "contacts_rate", 100, 0, 1e9);
+  p.particles_rate = param_number(pnh, "particles_rate", 5, 1e-3, 1e3);
+  p.markers_rate = param_number(pnh, "markers_rate", 1, 1e-3, 1e3);
+  const std::string vc = param_text(pnh, "visual_clock", "wall");
+  if (vc != "wall" && vc != "sim") throw std::invalid_argument("parameter ~visual_clock = '" + vc + "': allowed wall or sim");
+  p.visual_sim_clock = vc == "sim";
+  p.max_contact_points = int(param_number(pnh, "max_contact_points", 32, 0, 10000));
+  p.out_dir = param_text(pnh, "out_dir", "");
+  p.cache_dir = param_text(pnh, "cache_dir", "");
+  p.start_paused = param_bool(pnh, "start_paused", false);
+  p.shutdown_at_end = param_bool(pnh, "shutdown_at_end", false);
+  p.threads = int(param_number(pnh, "threads", 0, 0, 256));
+  return p;
+}
+
+TwinNode::TwinNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeParams& p) : nh_(nh), pnh_(pnh), p_(p) {
+#ifdef _OPENMP
+  if (p_.threads > 0) omp_set_num_threads(p_.threads);
+#endif
+  rt::TwinOptions to;
+  to.file = p_.scenario_file;
+  to.overrides = p_.overrides;
+  to.landing.cache_dir = p_.cache_dir;
+  to.landing.quiet = false;
+  twin_ = std::make_unique<rt::Twin>(to);
+  paused_ = p_.start_paused;
+
+  clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  body_pub_ = pnh_.advertise<regolith_twin::BodyStates>("body_states", 100);
+  contacts_pub_ = pnh_.advertise<regolith_twin::Contacts>("contacts", 10);
+  landing_pub_ = pnh_.advertise<regolith_twin::LandingOutcome>("landing", 10, true);
+  status_pub_ = pnh_.advertise<regolith_twin::Status>("status", 10);
+  particles_pub_ = pnh_.advertise<sensor_msgs::PointCloud2>("particles", 2);
+  markers_pub_ = pnh_.advertise<visualization_msgs::MarkerArray>("markers", 2, true);
+  contact_markers_pub_ = pnh_.advertise<visualization_msgs::MarkerArray>("contact_markers", 10);
+  diag_pub_ = nh_.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
+
+  services_.push_back(pnh_.advertiseService("pause", &TwinNode::on_pause, this));
+  services_.push_back(pnh_.advertiseService("unpause", &TwinNode::on_unpause, this));
+  services_.push_back(pnh_.advertiseService("reset", &TwinNode::on_reset, this));
+  services_.push_back(pnh_.advertiseService("step", &TwinNode::on_step, this));
+  services_.push_back(pnh_.advertiseService("save_checkpoint", &TwinNode::on_save, this));
+  services_.push_back(pnh_.advertiseService("load_checkpoint", &TwinNode::on_load, this));
+  services_.push_back(pnh_.advertiseService("set_body_state", &TwinNode::on_set_body_state, this));
+  services_.push_back(pnh_.advertiseService("apply_body_wrench", &TwinNode::on_apply_wrench, this));
+
+  // robot_description of every URDF body, in the body's namespace.
+  for (const rt::BodyModel& b : twin_->model().bodies) {
+    if (b.urdf_file.empty()) continue;
+    std::ifstream f(b.urdf_file);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    nh_.setParam(b.name + "/robot_description", ss.str());
+  }
+  start_wall_ = WallClock::now();
+  publish_static();
+}
+
+TwinNode::~TwinNode() { stop(); }
+
+void TwinNode::start() {
+  if (running_) return;
+  running_ = true;
+  reset_pacing();
+  {
+    std::lock_guard<std::mutex> lk(mu_);
+    after_step(true);
+  }
+  thread_ = std::thread([this] { loop(); });
+}
+
+void TwinNode::stop() {
+  running_ = false;
+  cv_.notify_all();
+  step_cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+double TwinNode::sim_time() {
+  std::lock_guard<std::mutex> lk(mu_);
+  return twin_->state().time;
+}
+double TwinNode::dt() {
+  std::lock_guard<std::mutex> lk(mu_);
+  return twin_->model().dt;
+}
+bool TwinNode::paused() {
+  std::lock_guard<std::mutex> lk(mu_);
+  return paused_;
+}
+bool TwinNode::ended() {
+  std::lock_guard<std::mutex> lk(mu_);
+  return twin_->ended();
+}
+
+void TwinNode::reset_pacing() {
+  pace_wall0_ = WallClock::now();
+  pace_sim0_ = twin_->state().time;
+}
+
+void TwinNode::loop() {
+#ifdef _OPENMP
+  if (p_.threads > 0) omp_set_num_threads(p_.threads);  // per thread: this one steps the engine
+#endif
+  while (running_ && ros::ok()) {
+    std::unique_lock<std::mutex> lk(mu_);
+    if ((paused_ || failed_) && pending_steps_ == 0) {
+      cv_.wait_for(lk, std::chrono::milliseconds(50));
+      // A paused twin keeps /clock and status alive (wall-time throttled).
+      const auto now = WallClock::now();
+      if (now - last_clock_wall_ >= std::chrono::milliseconds(100)) publish_clock();
+      if (std::chrono::duration<double>(now - last_status_wall_).count() >= 1.0 / p_.status_rate) publish_status();
+      reset_pacing();
+      continue;
+    }
+    try {
+      twin_->step();
+    } catch (const rt::BlowUpError& e) {
+      failed_ = true;
+      paused_ = true;
+      failure_ = e.what();
+      pending_steps_ = 0;
+      step_cv_.notify_all();
+      ROS_ERROR("twin_node: %s (the run is stopped; reset or load a checkpoint to go on)", e.what());
+      publish_diagnostics(diagnostic_msgs::DiagnosticStatus::ERROR, failure_);
+      after_step(true);
+      on_end();
+      continue;
+    }
+    if (pending_steps_ > 0 && --pending_steps_ == 0) step_cv_.notify_all();
+    after_step(false);
+    if (twin_->ended() && !end_handled_) on_end();
+    lk.unlock();
+    if (p_.realtime_factor > 0 && pending_steps_ == 0) {
+      const double ahead = (twin_->state().time - pace_sim0_) / p_.realtime_factor -
+                           std::chrono::duration<double>(WallClock::now() - pace_wall0_).count();
+      if (ahead > 0) std::this_thread::sleep_for(std::chrono::duration<double>(std::min(ahead, 0.1)));
+    }
+  }
+}
+
+void TwinNode::on_end() {
+  end_handled_ = true;
+  const rt::LandingScene* ls = twin_->landing_scene();
+  if (ls) {
+    rt::LandingOutcome o = twin_->outcome();
+    if (failed_) {
+      o.status = "blow_up";
+      o.message = failure_;
+    }
+    ROS_INFO("twin_node: landing ended (%s): %s, speed ratio %.3f, collision %.3g s, penetration %.3g m",
+             failed_ ? "blow-up" : o.ended_by.c_str(), o.lifted_off ? "lifted off" : "no lift-off", o.speed_ratio,
+             o.collision_duration, o.max_penetration);
+    if (!p_.out_dir.empty()) {
+      int threads = 0;
+#ifdef _OPENMP
+      threads = omp_get_max_threads();
+#endif
+      ::system(("mkdir -p '" + p_.out_dir + "'").c_str());
+      rt::write_landing_summary(p_.out_dir + "/summary.json", *ls, o, threads);
+      ROS_INFO("twin_node: summary written to %s/summary.json", p_.out_dir.c_str());
+    }
+  }
+  publish_landing();
+  paused_ = true;  // stays up for inspection; unpause steps on past the run end
+  if (p_.shutdown_at_end) ros::requestShutdown();
+}
+
+// Publications after a step, each on its own clock (called with mu_ held).
+void TwinNode::after_step(bool force) {
+  const double t = twin_->state().time;
+  const auto now = WallClock::now();
+  const bool clock_due = force || t - last_clock_sim_ >= 1.0 / p_.clock_rate - 1e-12 ||
+                         now - last_clock_wall_ >= std::chrono::milliseconds(100);
+  if (clock_due) {
+    publish_clock();
+    publish_tf();
+  }
+  if (force || p_.body_state_rate <= 0 || t - last_body_sim_ >= 1.0 / p_.body_state_rate - 1e-12) {
+    last_body_sim_ = t;
+    publish_body_states();
+  }
+  if ((contacts_pub_.getNumSubscribers() > 0 || contact_markers_pub_.getNumSubscribers() > 0) &&
+      (force || p_.contacts_rate <= 0 || t - last_contacts_sim_ >= 1.0 / p_.contacts_rate - 1e-12)) {
+    last_contacts_sim_ = t;
+    publish_contacts();
+  }
+  if (twin_->is_landing()) {
+    const std::string phase = twin_->phase();
+    if (clock_due || phase != last_phase_) publish_landing();
+    last_phase_ = phase;
+  }
+  if (force || std::chrono::duration<double>(now - last_status_wall_).count() >= 1.0 / p_.status_rate)
+    publish_status();
+  const double vis_now = p_.visual_sim_clock ? t : std::chrono::duration<double>(now - start_wall_).count();
+  if (particles_pub_.getNumSubscribers() > 0 && (force || vis_now - last_particles_ >= 1.0 / p_.particles_rate - 1e-12)) {
+    last_particles_ = vis_now;
+    publish_particles();
+  }
+  if (force || vis_now - last_markers_ >= 1.0 / p_.markers_rate - 1e-12) {
+    last_markers_ = vis_now;
+    if (markers_pub_.getNumSubscribers() > 0 || force) publish_markers();
+  }
+  if (std::chrono::duration<double>(now - last_diag_wall_).count() >= 1.0) {
+    const rt::StepStats& st = twin_->state().stats;
+    const double limit = twin_->model().guards.max_overlap_ratio;
+    if (failed_)
+      publish_diagnostics(diagnostic_msgs::DiagnosticStatus::ERROR, failure_);
+    else if (st.max_overlap_ratio > 0.5 * limit)
+      publish_diagnostics(diagnostic_msgs::DiagnosticStatus::WARN, "overlap above half the guard limit");
+    else
+      publish_diagnostics(diagnostic_msgs::DiagnosticStatus::OK, "running");
+  }
+}
+
+void TwinNode::publish_clock() {
+  rosgraph_msgs::Clock c;
+  c.clock = stamp(twin_->state().time);
+  clock_pub_.publish(c);
+  last_clock_sim_ = twin_->state().time;
+  last_clock_wall_ = WallClock::now();
+}
+
+void TwinNode::publish_tf() {
+  const rt::Model& m = twin_->model();
+  const rt::State& s = twin_->state();
+  std::vector<geometry_msgs::TransformStamped> out;
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    const rt::BodyModel& bm = m.bodies[b];
+    const rt::BodyState& bs = s.bodies[b];
+    const Quat q = rt::reference_rotation(bm, bs.q);
+    const Vec3 p = rt::reference_position(bm, bs.pos, bs.q);
+    geometry_msgs::TransformStamped tr;
+    tr.header.stamp = stamp(s.time);
+    tr.header.frame_id = "world";
+    tr.child_frame_id = frame_of(bm, bm.ref_frame);
+    tr.transform.translation = to_vector(p);
+    tr.transform.rotation = to_quat(q);
+    out.push_back(tr);
+  }
+  if (!out.empty()) tf_.sendTransform(out);
+}
+
+void TwinNode::publish_static() {
+  std::vector<geometry_msgs::TransformStamped> out;
+  const rt::Model& m = twin_->model();
+  for (const rt::BodyModel& bm : m.bodies)
+    for (const rt::BodyFrame& f : bm.frames) {
+      if (f.parent.empty()) continue;
+      geometry_msgs::TransformStamped tr;
+      tr.header.stamp = stamp(twin_->state().time);
+      tr.header.frame_id = frame_of(bm, f.parent);
+      tr.child_frame_id = frame_of(bm, f.name);
+      tr.transform.translation = to_vector(f.pos);
+      tr.transform.rotation = to_quat(f.rot);
+      out.push_back(tr);
+    }
+  // A gravity frame when g is tilted: its -z axis along gravity.
+  const Vec3 g = m.gravity;
+  if (g.norm() > 0 && std::fabs(g.normalized().z() + 1) > 1e-12) {
+    geometry_msgs::TransformStamped tr;
+    tr.header.stamp = stamp(twin_->state().time);
+    tr.header.frame_id = "world";
+    tr.child_frame_id = "gravity";
+    tr.transform.rotation = to_quat(Quat::FromTwoVectors(Vec3(0, 0, -1), g.normalized()));
+    out.push_back(tr);
+  }
+  if (!out.empty()) static_tf_.sendTransform(out);
+}
+
+void TwinNode::publish_body_states() {
+  const rt::Model& m = twin_->model();
+  const rt::State& s = twin_->state();
+  regolith_twin::BodyStates msg;
+  msg.header.stamp = stamp(s.time);
+  msg.header.frame_id = "world";
+  msg.step = s.step;
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    const rt::BodyModel& bm = m.bodies[b];
+    const rt::BodyState& bs = s.bodies[b];
+    regolith_twin::BodyState o;
+    o.name = bm.name;
+    o.pose.position = to_point(rt::reference_position(bm, bs.pos, bs.q));
+    o.pose.orientation = to_quat(rt::reference_rotation(bm, bs.q));
+    o.center_of_mass = to_point(bs.pos);
+    o.twist.linear = to_vector(bs.vel);
+    o.twist.angular = to_vector(bs.omega);
+    o.wrench.force = to_vector(bs.force);
+    o.wrench.torque = to_vector(bs.torque);
+    const rt::BodyContacts c = twin_->contacts(int(b));
+    o.contacts = uint32_t(c.total);
+    o.bed_contacts = uint32_t(c.bed);
+    msg.bodies.push_back(o);
+  }
+  body_pub_.publish(msg);
+}
+
+void TwinNode::publish_contacts() {
+  const rt::Model& m = twin_->model();
+  const rt::State& s = twin_->state();
+  regolith_twin::Contacts msg;
+  msg.header.stamp = stamp(s.time);
+  msg.header.frame_id = "world";
+  struct Pt {
+    double depth;
+    Vec3 point, normal;
+  };
+  std::vector<Pt> pts;
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    const rt::BodyModel& bm = m.bodies[b];
+    const rt::BodyState& bs = s.bodies[b];
+    // Grains: the body's contact wrench less its body–body part.
+    Vec3 f = bs.force, tq = bs.torque;
+    for (const rt::BodyPointContact& c : s.body_points) {
+      if (c.a == int(b)) {
+        f -= c.force_a;
+        tq -= (c.point - bs.pos).cross(c.force_a);
+      } else if (c.b == int(b)) {
+        f += c.force_a;
+        tq += (c.point - bs.pos).cross(c.force_a);
+      }
+    }
+    pts.clear();
+    const rt::BodyGrainList& bl = s.body_grains;
+    for (int k = 0; k < bl.size(); ++k) {
+      if (!bl.touching[k] || bl.body[k] != int(b)) continue;
+      const Vec3 p = bs.q.conjugate() * (s.pos[bl.grain[k]] - bs.pos);
+      const rt::ShapeGap g = rt::shape_gap(bm, bm.shapes[bl.shape[k]], p, m.grain_radius[bl.grain[k]]);
+      pts.push_back({std::max(0.0, g.overlap), bs.pos + bs.q * g.point, bs.q * g.n});
+    }
+    if (pts.empty()) continue;
+    regolith_twin::BodyContact bc;
+    bc.body = bm.name;
+    bc.other = "grains";
+    bc.wrench.force = to_vector(f);
+    bc.wrench.torque = to_vector(tq);
+    bc.count = uint32_t(pts.size());
+    const size_t keep = std::min(pts.size(), size_t(p_.max_contact_points));
+    std::partial_sort(pts.begin(), pts.begin() + keep, pts.end(),
+                      [](const Pt& a, const Pt& c) { return a.depth > c.depth; });
+    for (size_t k = 0; k < keep; ++k) {
+      bc.points.push_back(to_point(pts[k].point));
+      bc.normals.push_back(to_vector(pts[k].normal));
+      bc.depths.push_back(pts[k].depth);
+    }
+    msg.contacts.push_back(bc);
+  }
+  // Body pairs.
+  for (size_t a = 0; a < m.bodies.size(); ++a)
+    for (size_t b = a + 1; b < m.bodies.size(); ++b) {
+      regolith_twin::BodyContact bc;
+      Vec3 f = Vec3::Zero(), tq = Vec3::Zero();
+      const Vec3 ca = s.bodies[a].pos;
+      pts.clear();
+      for (const rt::BodyPointContact& c : s.body_points) {
+        if (!((c.a == int(a) && c.b == int(b)) || (c.a == int(b) && c.b == int(a)))) continue;
+        const double sign = c.a == int(a) ? 1.0 : -1.0;  // force on a
+        f += sign * c.force_a;
+        tq += (c.point - ca).cross(sign * c.force_a);
+        pts.push_back({c.overlap, c.point, -sign * c.normal});  // into a
+      }
+      if (pts.empty()) continue;
+      bc.body = m.bodies[a].name;
+      bc.other = m.bodies[b].name;
+      bc.wrench.force = to_vector(f);
+      bc.wrench.torque = to_vector(tq);
+      bc.count = uint32_t(pts.size());
+      const size_t keep = std::min(pts.size(), size_t(p_.max_contact_points));
+      std::partial_sort(pts.begin(), pts.begin() + keep, pts.end(),
+                        [](const Pt& x, const Pt& y) { return x.depth > y.depth; });
+      for (size_t k = 0; k < keep; ++k) {
+        bc.points.push_back(to_point(pts[k].point));
+        bc.normals.push_back(to_vector(pts[k].normal));
+        bc.depths.push_back(pts[k].depth);
+      }
+      msg.contacts.push_back(bc);
+    }
+  contacts_pub_.publish(msg);
+  if (contact_markers_pub_.getNumSubscribers() == 0) return;
+  // One arrow per pair at the mean listed point, along the force on the body
+  // (length saturating: 0.3 m * |F| / (|F| + 0.01 N)).
+  visualization_msgs::MarkerArray arr;
+  visualization_msgs::Marker clear;
+  clear.action = visualization_msgs::Marker::DELETEALL;
+  arr.markers.push_back(clear);
+  int id = 0;
+  for (const auto& bc : msg.contacts) {
+    if (bc.points.empty()) continue;
+    Vec3 c = Vec3::Zero();
+    for (const auto& p : bc.points) c += Vec3(p.x, p.y, p.z);
+    c /= double(bc.points.size());
+    const Vec3 f = from_vector(bc.wrench.force);
+    const double n = f.norm();
+    if (!(n > 0)) continue;
+    visualization_msgs::Marker mk;
+    mk.header = msg.header;
+    mk.ns = "contact_wrench";
+    mk.id = id++;
+    mk.type = visualization_msgs::Marker::ARROW;
+    mk.action = visualization_msgs::Marker::ADD;
+    mk.pose.orientation.w = 1;
+    mk.points.push_back(to_point(c));
+    mk.points.push_back(to_point(c + f / n * (0.3 * n / (n + 0.01))));
+    mk.scale.x = 0.01;
+    mk.scale.y = 0.02;
+    mk.scale.z = 0.03;
+    mk.color.r = 1.0f;
+    mk.color.g = 0.2f;
+    mk.color.b = 0.2f;
+    mk.color.a = 1.0f;
+    arr.markers.push_back(mk);
+  }
+  contact_markers_pub_.publish(arr);
+}
+
+void TwinNode::publish_landing() {
+  if (!twin_->is_landing()) return;
+  const rt::LandingOutcome o = twin_->outcome();
+  regolith_twin::LandingOutcome msg;
+  msg.header.stamp = stamp(twin_->state().time);
+  msg.phase = twin_->phase();
+  msg.ended_by = o.ended_by;
+  msg.contact = o.contact;
+  msg.lifted_off = o.lifted_off;
+  msg.cancelled_liftoffs = o.relandings;
+  msg.t_contact = o.t_contact;
+  msg.t_liftoff = o.t_liftoff;
+  msg.v_in = o.v_in;
+  msg.v_out = o.v_out;
+  msg.speed_ratio = o.speed_ratio;
+  msg.energy_ratio = o.energy_ratio;
+  msg.angle_out_deg = o.angle_out_deg;
+  msg.spin_out = o.spin_out;
+  msg.collision_duration = o.collision_duration;
+  msg.max_penetration = o.max_penetration;
+  msg.travel_distance = o.travel_distance;
+  msg.travel_time = o.travel_time;
+  msg.ejected_volume = o.ejected_volume;
+  msg.ejected_grains = o.ejected_grains;
+  msg.lowest_corner = twin_->lowest_corner();
+  landing_pub_.publish(msg);
+}
+
+void TwinNode::publish_status() {
+  const rt::Model& m = twin_->model();
+  const rt::State& s = twin_->state();
+  const auto now = WallClock::now();
+  const double wall = std::chrono::duration<double>(now - last_status_wall_).count();
+  regolith_twin::Status msg;
+  msg.header.stamp = stamp(s.time);
+  msg.sim_time = s.time;
+  msg.step = s.step;
+  msg.dt = m.dt;
+  if (wall > 0 && wall < 1e6) {
+    msg.realtime_factor = (s.time - status_sim0_) / wall;
+    msg.steps_per_second = double(s.step - status_step0_) / wall;
+  }
+  msg.paused = paused_;
+  msg.grains = uint32_t(m.n_grains);
+  uint32_t frozen = 0;
+  for (int i = 0; i < m.n_grains; ++i) frozen += m.grain_inv_mass[i] == 0;
+  msg.frozen_grains = frozen;
+  msg.active_grains = uint32_t(m.n_grains) - frozen;
+  msg.max_overlap_ratio = s.stats.max_overlap_ratio;
+  double ke = rt::energy(m, s).kinetic();
+  for (size_t b = 0; b < m.bodies.size(); ++b)
+    if (!m.bodies[b].fixed) ke += rt::body_lin_energy(m.bodies[b], s.bodies[b]) + rt::body_rot_energy(m.bodies[b], s.bodies[b]);
+  msg.kinetic_energy = ke;
+  status_pub_.publish(msg);
+  last_status_wall_ = now;
+  status_sim0_ = s.time;
+  status_step0_ = s.step;
+}
+
+void TwinNode::publish_particles() {
+  const rt::Model& m = twin_->model();
+  const rt::State& s = twin_->state();
+  sensor_msgs::PointCloud2 cloud;
+  cloud.header.stamp = stamp(s.time);
+  cloud.header.frame_id = "world";
+  sensor_msgs::PointCloud2Modifier mod(cloud);
+  mod.setPointCloud2Fields(6, "x", 1, sensor_msgs::PointField::FLOAT32, "y", 1, sensor_msgs::PointField::FLOAT32, "z",
+                           1, sensor_msgs::PointField::FLOAT32, "radius", 1, sensor_msgs::PointField::FLOAT32, "speed",
+                           1, sensor_msgs::PointField::FLOAT32, "id", 1, sensor_msgs::PointField::UINT32);
+  mod.resize(size_t(m.n_grains));
+  sensor_msgs::PointCloud2Iterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z"), r(cloud, "radius"),
+      v(cloud, "speed");
+  sensor_msgs::PointCloud2Iterator<uint32_t> id(cloud, "id");
+  for (int i = 0; i < m.n_grains; ++i, ++x, ++y, ++z, ++r, ++v, ++id) {
+    *x = float(s.pos[i].x());
+    *y = float(s.pos[i].y());
+    *z = float(s.pos[i].z());
+    *r = float(m.grain_radius[i]);
+    *v = float(s.vel[i].norm());
+    *id = uint32_t(i);
+  }
+  particles_pub_.publish(cloud);
+}
+
+void TwinNode::publish_markers() {
+  const rt::Model& m = twin_->model();
+  const rt::State& s = twin_->state();
+  visualization_msgs::MarkerArray arr;
+  int id = 0;
+  auto base = [&](const std::string& ns, int type) {
+    visualization_msgs::Marker mk;
+    mk.header.stamp = stamp(s.time);
+    mk.header.frame_id = "world";
+    mk.ns = ns;
+    mk.id = id++;
+    mk.type = type;
+    mk.action = visualization_msgs::Marker::ADD;
+    mk.pose.orientation.w = 1;
+    mk.color.a = 1;
+    return mk;
+  };
+  // Walls: cylinders as translucent tubes, planes as thin squares.
+  for (const rt::Wall& w : m.walls) {
+    if (w.type == rt::WallType::Cylinder) {
+      auto mk = base("walls", visualization_msgs::Marker::CYLINDER);
+      const double len = w.length > 0 ? w.length : 0.5;
+      mk.pose.position = to_point(w.origin + w.axis * (0.5 * len));
+      mk.pose.orientation = to_quat(Quat::FromTwoVectors(Vec3::UnitZ(), w.axis));
+      mk.scale.x = mk.scale.y = 2 * w.radius;
+      mk.scale.z = len;
+      mk.color.r = mk.color.g = mk.color.b = 0.6f;
+      mk.color.a = 0.15f;
+      arr.markers.push_back(mk);
+    } else if (w.type == rt::WallType::Plane) {
+      auto mk = base("walls", visualization_msgs::Marker::CUBE);
+      mk.pose.position = to_point(w.origin);
+      mk.pose.orientation = to_quat(Quat::FromTwoVectors(Vec3::UnitZ(), w.axis));
+      mk.scale.x = mk.scale.y = 2.0;
+      mk.scale.z = 0.001;
+      mk.color.r = mk.color.g = mk.color.b = 0.4f;
+      mk.color.a = 0.3f;
+      arr.markers.push_back(mk);
+    }
+  }
+  // Bodies: one marker per shape.
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    const rt::BodyModel& bm = m.bodies[b];
+    const rt::BodyState& bs = s.bodies[b];
+    for (const rt::Shape& sh : bm.shapes) {
+      int type = visualization_msgs::Marker::CUBE;
+      Vec3 scale = 2 * sh.size;
+      if (sh.type == rt::ShapeType::Sphere || sh.type == rt::ShapeType::Ellipsoid) type = visualization_msgs::Marker::SPHERE;
+      if (sh.type == rt::ShapeType::Cylinder) type = visualization_msgs::Marker::CYLINDER;
+      if (sh.type == rt::ShapeType::Mesh) continue;
+      auto mk = base("bodies/" + bm.name, type);
+      mk.pose.position = to_point(bs.pos + bs.q * sh.pos);
+      mk.pose.orientation = to_quat(bs.q * sh.rot);
+      mk.scale.x = scale.x();
+      mk.scale.y = scale.y();
+      mk.scale.z = scale.z();
+      mk.color.r = bm.fixed ? 0.5f : 0.9f;
+      mk.color.g = bm.fixed ? 0.45f : 0.75f;
+      mk.color.b = bm.fixed ? 0.4f : 0.2f;
+      arr.markers.push_back(mk);
+    }
+  }
+  // Grains: SPHERE_LISTs, one per radius bin (a list has one scale), at most 8.
+  if (m.n_grains > 0) {
+    const auto [lo_it, hi_it] = std::minmax_element(m.grain_radius.begin(), m.grain_radius.end());
+    const double lo = *lo_it, hi = *hi_it;
+    const int bins = hi > lo * (1 + 1e-6) ? 8 : 1;
+    std::vector<visualization_msgs::Marker> lists;
+    for (int k = 0; k < bins; ++k) {
+      auto mk = base("grains", visualization_msgs::Marker::SPHERE_LIST);
+      const double r = bins == 1 ? lo : lo + (hi - lo) * (k + 0.5) / bins;
+      mk.scale.x = mk.scale.y = mk.scale.z = 2 * r;
+      mk.color.r = 0.55f;
+      mk.color.g = 0.5f;
+      mk.color.b = 0.45f;
+      lists.push_back(mk);
+    }
+    for (int i = 0; i < m.n_grains; ++i) {
+      const int k = bins == 1 ? 0 : std::min(bins - 1, int((m.grain_radius[i] - lo) / (hi - lo) * bins));
+      lists[k].points.push_back(to_point(s.pos[i]));
+    }
+    for (auto& mk : lists)
+      if (!mk.points.empty()) arr.markers.push_back(mk);
+  }
+  // Landing outcome as text above the bed.
+  if (twin_->is_landing()) {
+    const rt::LandingOutcome o = twin_->outcome();
+    auto mk = base("outcome", visualization_msgs::Marker::TEXT_VIEW_FACING);
+    const rt::LandingSpec& sp = twin_->landing_scene()->run_spec;
+    mk.pose.position = to_point(Vec3(0, 0, sp.rim + 0.6));
+    mk.scale.z = 0.06;
+    mk.color.r = mk.color.g = mk.color.b = 1.0f;
+    char text[256];
+    std::snprintf(text, sizeof text, "t = %.2f s  %s  penetration %.1f cm  speed ratio %.3f", s.time, twin_->phase(),
+                  100 * o.max_penetration, o.speed_ratio);
+    mk.text = text;
+    arr.markers.push_back(mk);
+  }
+  markers_pub_.publish(arr);
+}
+
+void TwinNode::publish_diagnostics(int level, const std::string& message) {
+  diagnostic_msgs::DiagnosticArray arr;
+  arr.header.stamp = stamp(twin_->state().time);
+  diagnostic_msgs::DiagnosticStatus st;
+  st.level = static_cast<decltype(st.level)>(level);
+  st.name = "regolith_twin: guards";
+  st.hardware_id = twin_->name();
+  st.message = message;
+  auto kv = [&](const std::string& k, double v) {
+    diagnostic_msgs::KeyValue x;
+    x.key = k;
+    x.value = std::to_string(v);
+    st.values.push_back(x);
+  };
+  const rt::StepStats& s = twin_->state().stats;
+  kv("max_overlap_ratio", s.max_overlap_ratio);
+  kv("overlap_limit", twin_->model().guards.max_overlap_ratio);
+  kv("dt", twin_->model().dt);
+  kv("sim_time", twin_->state().time);
+  arr.status.push_back(st);
+  diag_pub_.publish(arr);
+  last_diag_wall_ = WallClock::now();
+}
+
+// --- services -------------------------------------------------------------------
+
+bool TwinNode::on_pause(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  std::lock_guard<std::mutex> lk(mu_);
+  paused_ = true;
+  res.success = true;
+  res.message = "paused at t = " + std::to_string(twin_->state().time) + " s";
+  return true;
+}
+
+bool TwinNode::on_unpause(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  std::lock_guard<std::mutex> lk(mu_);
+  if (failed_) {
+    res.success = false;
+    res.message = "the run stopped on a blow-up (" + failure_ + "); reset or load a checkpoint first";
+    return true;
+  }
+  paused_ = false;
+  reset_pacing();
+  cv_.notify_all();
+  res.success = true;
+  res.message = "running";
+  return true;
+}
+
+bool TwinNode::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  std::lock_guard<std::mutex> lk(mu_);
+  twin_->reset();
+  failed_ = false;
+  failure_.clear();
+  end_handled_ = false;
+  last_phase_.clear();
+  last_clock_sim_ = last_body_sim_ = last_contacts_sim_ = -1e300;
+  reset_pacing();
+  after_step(true);
+  res.success = true;
+  res.message = "reset to t = " + std::to_string(twin_->state().time) + " s";
+  return true;
+}
+
+bool TwinNode::on_step(regolith_twin::Step::Request& req, regolith_twin::Step::Response& res) {
+  std::unique_lock<std::mutex> lk(mu_);
+  if (req.steps <= 0 || req.steps > 100000000) {
+    res.success = false;
+    res.message = "steps = " + std::to_string(req.steps) + ": allowed range [1, 100000000]";
+  } else if (!paused_) {
+    res.success = false;
+    res.message = "refused while running: call ~pause first";
+  } else if (failed_) {
+    res.success = false;
+    res.message = "the run stopped on a blow-up (" + failure_ + "); reset or load a checkpoint first";
+  } else if (pending_steps_ > 0) {
+    res.success = false;
+    res.message = "another step request is in progress";
+  } else {
+    pending_steps_ = req.steps;
+    cv_.notify_all();
+    step_cv_.wait(lk, [&] { return pending_steps_ == 0 || !running_; });
+    res.success = !failed_ && running_;
+    res.message = failed_ ? failure_ : (running_ ? "ok" : "node stopping");
+  }
+  res.sim_time = twin_->state().time;
+  return true;
+}
+
+bool TwinNode::on_save(regolith_twin::Checkpoint::Request& req, regolith_twin::Checkpoint::Response& res) {
+  std::lock_guard<std::mutex> lk(mu_);
+  try {
+    if (req.path.empty()) throw rt::InputError("path is empty");
+    twin_->save(req.path);
+    res.success = true;
+    res.message = "saved t = " + std::to_string(twin_->state().time) + " s to " + req.path;
+  } catch (const std::exception& e) {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;
+}
+
+bool TwinNode::on_load(regolith_twin::Checkpoint::Request& req, regolith_twin::Checkpoint::Response& res) {
+  std::lock_guard<std::mutex> lk(mu_);
+  try {
+    if (!std::ifstream(req.path).good()) throw rt::InputError(req.path + ": cannot read the file");
+    twin_->load(req.path);
+    failed_ = false;
+    failure_.clear();
+    end_handled_ = false;
+    last_clock_sim_ = last_body_sim_ = last_contacts_sim_ = -1e300;
+    reset_pacing();
+    after_step(true);
+    res.success = true;
+    res.message = "loaded t = " + std::to_string(twin_->state().time) + " s from " + req.path;
+  } catch (const std::exception& e) {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;
+}
+
+bool TwinNode::on_set_body_state(regolith_twin::SetBodyState::Request& req, regolith_twin::SetBodyState::Response& res) {
+  std::lock_guard<std::mutex> lk(mu_);
+  const int b = twin_->body_index(req.body);
+  const auto& o = req.pose.orientation;
+  const double qn = std::sqrt(o.w * o.w + o.x * o.x + o.y * o.y + o.z * o.z);
+  if (b < 0) {
+    res.success = false;
+    res.message = "no body named '" + req.body + "'";
+  } else if (!(qn > 1e-9) || !std::isfinite(qn)) {
+    res.success = false;
+    res.message = "pose.orientation is not a valid quaternion";
+  } else if (twin_->model().bodies[b].fixed) {
+    res.success = false;
+    res.message = "body '" + req.body + "' is fixed";
+  } else {
+    const auto& p = req.pose.position;
+    twin_->set_body_state(b, Vec3(p.x, p.y, p.z), Quat(o.w, o.x, o.y, o.z), from_vector(req.twist.linear),
+                          from_vector(req.twist.angular));
+    publish_body_states();
+    res.success = true;
+    res.message = "ok";
+  }
+  return true;
+}
+
+bool TwinNode::on_apply_wrench(regolith_twin::ApplyBodyWrench::Request& req,
+                               regolith_twin::ApplyBodyWrench::Response& res) {
+  std::lock_guard<std::mutex> lk(mu_);
+  const int b = twin_->body_index(req.body);
+  if (b < 0) {
+    res.success = false;
+    res.message = "no body named '" + req.body + "'";
+  } else if (!(req.duration > 0) || !std::isfinite(req.duration)) {
+    res.success = false;
+    res.message = "duration = " + std::to_string(req.duration) + ": must be > 0 s";
+  } else if (twin_->model().bodies[b].fixed) {
+    res.success = false;
+    res.message = "body '" + req.body + "' is fixed";
+  } else {
+    const Vec3 f = from_vector(req.wrench.force), t = from_vector(req.wrench.torque);
+    if (!f.allFinite() || !t.allFinite()) {
+      res.success = false;
+      res.message = "wrench has non-finite components";
+    } else {
+      twin_->apply_wrench(b, f, t, twin_->state().time + req.duration);
+      res.success = true;
+      res.message = "ok";
+    }
+  }
+  return true;
+}
+
+}  // namespace rt_ros

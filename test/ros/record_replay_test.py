@@ -1,0 +1,79 @@
+#!/usr/bin/env python3
+"""Record -> replay: record the twin's topics with rosbag while the short plate
+landing runs, recompute the outcome from the recorded body states with
+regolith_bag_outcome, and compare it with the node's summary.json."""
+import json
+import os
+import shutil
+import signal
+import subprocess
+import time
+import unittest
+
+import rosgraph
+import roslib.packages
+import rospy
+import rostest
+from std_srvs.srv import Trigger
+
+TOPICS = ["/twin_node/body_states", "/twin_node/landing", "/twin_node/status", "/tf", "/tf_static"]
+
+
+def subscribed(topic):
+    _, subs, _ = rosgraph.Master("/record_replay").getSystemState()
+    return any(name == topic and nodes for name, nodes in subs)
+
+
+class RecordReplay(unittest.TestCase):
+    def test_replayed_outcome_equals_summary(self):
+        out = rospy.get_param("~out")
+        scenario = rospy.get_param("~scenario_file")
+        shutil.rmtree(out, ignore_errors=True)
+        os.makedirs(out)
+        bag = os.path.join(out, "run.bag")
+        rospy.wait_for_service("/twin_node/unpause", timeout=60)
+        rec = subprocess.Popen(["rosbag", "record", "--quiet", "-O", bag] + TOPICS)
+        try:
+            deadline = time.time() + 30
+            while not all(subscribed(t) for t in TOPICS[:3]):
+                self.assertLess(time.time(), deadline, "rosbag did not subscribe")
+                time.sleep(0.1)
+            time.sleep(0.5)
+            self.assertTrue(rospy.ServiceProxy("/twin_node/unpause", Trigger)().success)
+            summary = os.path.join(out, "summary.json")
+            deadline = time.time() + 60
+            while not os.path.exists(summary):
+                self.assertLess(time.time(), deadline, "the landing did not end")
+                time.sleep(0.2)
+            time.sleep(1.0)  # the last messages reach the recorder
+        finally:
+            rec.send_signal(signal.SIGINT)
+            rec.wait(timeout=30)
+        self.assertTrue(os.path.exists(bag), "no bag written")
+        tool = roslib.packages.find_node("regolith_twin", "regolith_bag_outcome")
+        self.assertTrue(tool, "regolith_bag_outcome not built")
+        replay = os.path.join(out, "replay.json")
+        r = subprocess.run([tool[0], bag, scenario, "--out", replay], capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(summary) as f:
+            run = json.load(f)
+        with open(replay) as f:
+            rep = json.load(f)
+        dt = run["run"]["dt"]
+        a, b = run["outcome"], rep["outcome"]
+        self.assertTrue(a["contact"] and a["lifted_off"], "the test landing must touch down and lift off")
+        for key in ("contact", "lifted_off", "ended_by", "cancelled_liftoffs"):
+            self.assertEqual(a[key], b[key], key)
+        # Times travel as ROS stamps (1 ns); the rest through the pose and twist messages.
+        for key in ("t_contact", "t_liftoff", "collision_duration"):
+            self.assertAlmostEqual(a[key], b[key], delta=2e-9, msg=key)
+        self.assertAlmostEqual(a["t_end"], b["t_end"], delta=1.01 * dt, msg="t_end")
+        for key in ("v_in", "v_out", "speed_ratio", "E_lin_in", "E_lin_out", "E_rot_out", "energy_ratio",
+                    "angle_out_deg", "spin_out", "max_penetration", "h_liftoff", "travel_distance",
+                    "travel_time", "second_impact_speed", "second_impact_angle_deg"):
+            self.assertAlmostEqual(a[key], b[key], delta=1e-9 * max(1.0, abs(a[key])), msg=key)
+
+
+if __name__ == "__main__":
+    rospy.init_node("record_replay")
+    rostest.rosrun("regolith_twin", "record_replay", RecordReplay)

@@ -1,0 +1,276 @@
+// The node's services, in process: a TwinNode on the short plate landing,
+// driven through pause / step / reset / checkpoints / body state / wrench,
+// with every answer checked against the engine (an rt::Twin of the same file
+// stepped directly) or against the physics (a push changes the velocity by
+// F t / M in free flight).
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <std_srvs/Trigger.h>
+
+#include <cstdio>
+#include <memory>
+#include <mutex>
+#include <unistd.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "regolith_twin/ApplyBodyWrench.h"
+#include "regolith_twin/BodyStates.h"
+#include "regolith_twin/Checkpoint.h"
+#include "regolith_twin/SetBodyState.h"
+#include "regolith_twin/Step.h"
+#include "regolith_twin/ros/twin_node.hpp"
+
+namespace {
+
+std::unique_ptr<rt_ros::TwinNode> g_node;
+rt_ros::NodeParams g_params;
+
+// The latest body_states message.
+std::mutex g_mu;
+regolith_twin::BodyStates g_last;
+void on_states(const regolith_twin::BodyStates::ConstPtr& m) {
+  std::lock_guard<std::mutex> lk(g_mu);
+  g_last = *m;
+}
+
+// Waits until a body_states message of step `step` has arrived; returns it.
+regolith_twin::BodyStates states_at(long step) {
+  for (int k = 0; k < 500; ++k) {
+    {
+      std::lock_guard<std::mutex> lk(g_mu);
+      if (g_last.step == step) return g_last;
+    }
+    ros::WallDuration(0.01).sleep();
+  }
+  ADD_FAILURE() << "no body_states message for step " << step;
+  return {};
+}
+
+std::string srv(const std::string& name) { return ros::names::resolve("~" + name); }
+
+bool trigger(const std::string& name, std::string* message = nullptr) {
+  std_srvs::Trigger t;
+  EXPECT_TRUE(ros::service::call(srv(name), t)) << name;
+  if (message) *message = t.response.message;
+  return t.response.success;
+}
+
+regolith_twin::Step::Response step(long n) {
+  regolith_twin::Step s;
+  s.request.steps = n;
+  EXPECT_TRUE(ros::service::call(srv("step"), s));
+  return s.response;
+}
+
+rt::Twin reference_twin() {
+  rt::TwinOptions to;
+  to.file = g_params.scenario_file;
+  to.landing.quiet = true;
+  return rt::Twin(to);
+}
+
+const regolith_twin::BodyState& body(const regolith_twin::BodyStates& m, const std::string& name) {
+  for (const auto& b : m.bodies)
+    if (b.name == name) return b;
+  throw std::runtime_error("no body " + name);
+}
+
+}  // namespace
+
+TEST(TwinNodeServices, StepAdvancesBySteps_AndBodiesMoveAsTheEngine) {
+  ASSERT_TRUE(trigger("reset"));
+  ASSERT_TRUE(trigger("pause"));
+  const double t0 = g_node->sim_time(), dt = g_node->dt();
+  const auto r = step(250);
+  ASSERT_TRUE(r.success) << r.message;
+  EXPECT_NEAR(r.sim_time, t0 + 250 * dt, 1e-9 * dt);
+  EXPECT_NEAR(g_node->sim_time(), t0 + 250 * dt, 1e-9 * dt);
+  // The same 250 steps taken directly with the engine: identical centre of mass and velocity.
+  rt::Twin ref = reference_twin();
+  const long s0 = ref.state().step;
+  for (int k = 0; k < 250; ++k) ref.step();
+  const auto m = states_at(s0 + 250);
+  const auto& b = body(m, "mascot");
+  const rt::BodyState& e = ref.state().bodies[ref.body_index("mascot")];
+  EXPECT_EQ(b.center_of_mass.x, e.pos.x());
+  EXPECT_EQ(b.center_of_mass.y, e.pos.y());
+  EXPECT_EQ(b.center_of_mass.z, e.pos.z());
+  EXPECT_EQ(b.twist.linear.z, e.vel.z());
+  EXPECT_EQ(b.twist.angular.x, e.omega.x());
+  EXPECT_GT(b.contacts, 0u) << "250 steps reach the plate (first contact after about 100)";
+}
+
+TEST(TwinNodeServices, StepIsRefusedWhileRunning_AndBadCountsAreRefused) {
+  ASSERT_TRUE(trigger("pause"));
+  ASSERT_TRUE(trigger("reset"));
+  // Lift the lander 50 m: a fall of seconds of wall time, so the run cannot
+  // end (and pause itself) before the refused request below arrives.
+  regolith_twin::SetBodyState set;
+  set.request.body = "mascot";
+  {
+    std::lock_guard<std::mutex> lk(g_mu);
+    set.request.pose = body(g_last, "mascot").pose;
+  }
+  set.request.pose.position.z += 50;
+  ASSERT_TRUE(ros::service::call(srv("set_body_state"), set));
+  ASSERT_TRUE(set.response.success) << set.response.message;
+  ASSERT_TRUE(trigger("unpause"));
+  auto r = step(10);
+  EXPECT_FALSE(r.success);
+  EXPECT_NE(r.message.find("refused while running"), std::string::npos) << r.message;
+  ASSERT_TRUE(trigger("pause"));
+  r = step(-5);
+  EXPECT_FALSE(r.success);
+  EXPECT_NE(r.message.find("allowed range"), std::string::npos) << r.message;
+  r = step(0);
+  EXPECT_FALSE(r.success);
+  r = step(3);  // the node still answers
+  EXPECT_TRUE(r.success) << r.message;
+}
+
+TEST(TwinNodeServices, ResetRestoresTheStart) {
+  ASSERT_TRUE(trigger("pause"));
+  ASSERT_TRUE(trigger("reset"));
+  rt::Twin ref = reference_twin();
+  const double t_start = ref.state().time;
+  EXPECT_EQ(g_node->sim_time(), t_start);
+  ASSERT_TRUE(step(40).success);
+  ASSERT_TRUE(trigger("reset"));
+  EXPECT_EQ(g_node->sim_time(), t_start);
+  const auto m = states_at(ref.state().step);
+  const rt::BodyState& e = ref.state().bodies[ref.body_index("mascot")];
+  EXPECT_EQ(body(m, "mascot").center_of_mass.z, e.pos.z());
+  EXPECT_EQ(body(m, "mascot").twist.linear.x, e.vel.x());
+}
+
+TEST(TwinNodeServices, CheckpointContinuesBitIdentically) {
+  ASSERT_TRUE(trigger("pause"));
+  ASSERT_TRUE(trigger("reset"));
+  const long s0 = reference_twin().state().step;
+  ASSERT_TRUE(step(120).success);
+  const std::string path = "/tmp/regolith_twin_services_test_" + std::to_string(::getpid()) + ".ckpt";
+  regolith_twin::Checkpoint c;
+  c.request.path = path;
+  ASSERT_TRUE(ros::service::call(srv("save_checkpoint"), c));
+  ASSERT_TRUE(c.response.success) << c.response.message;
+  const double t1 = g_node->sim_time();
+  const auto a = step(200);
+  const regolith_twin::BodyStates first = states_at(s0 + 320);
+  ASSERT_TRUE(ros::service::call(srv("load_checkpoint"), c));
+  ASSERT_TRUE(c.response.success) << c.response.message;
+  EXPECT_EQ(g_node->sim_time(), t1);
+  {
+    std::lock_guard<std::mutex> lk(g_mu);
+    g_last.step = -1;  // wait for the repeated step below, not the first run's message
+  }
+  const auto b = step(200);
+  EXPECT_EQ(a.sim_time, b.sim_time);
+  const auto second = states_at(s0 + 320);
+  EXPECT_EQ(body(first, "mascot").center_of_mass.x, body(second, "mascot").center_of_mass.x);
+  EXPECT_EQ(body(first, "mascot").center_of_mass.z, body(second, "mascot").center_of_mass.z);
+  EXPECT_EQ(body(first, "mascot").twist.angular.y, body(second, "mascot").twist.angular.y);
+  std::remove(path.c_str());
+}
+
+TEST(TwinNodeServices, AppliedWrenchChangesVelocityByImpulse) {
+  ASSERT_TRUE(trigger("pause"));
+  ASSERT_TRUE(trigger("reset"));
+  rt::Twin ref = reference_twin();
+  const int b = ref.body_index("mascot");
+  const double mass = ref.model().bodies[b].mass, dt = g_node->dt();
+  const long s0 = ref.state().step;
+  const auto before = body(states_at(s0), "mascot");
+  // Lift the lander away from the plate first so that nothing touches it.
+  regolith_twin::SetBodyState set;
+  set.request.body = "mascot";
+  set.request.pose = before.pose;
+  set.request.pose.position.z += 0.5;
+  set.request.twist.linear.x = 0.1;
+  ASSERT_TRUE(ros::service::call(srv("set_body_state"), set));
+  ASSERT_TRUE(set.response.success) << set.response.message;
+  regolith_twin::ApplyBodyWrench w;
+  w.request.body = "mascot";
+  w.request.wrench.force.z = 3.0 * mass;  // 3 m/s^2 upwards
+  w.request.duration = 20 * dt;
+  ASSERT_TRUE(ros::service::call(srv("apply_body_wrench"), w));
+  ASSERT_TRUE(w.response.success) << w.response.message;
+  ASSERT_TRUE(step(40).success);
+  const auto after = body(states_at(s0 + 40), "mascot");
+  EXPECT_EQ(after.contacts, 0u);
+  // 20 steps pushed at 3 m/s^2 up, 40 steps of gravity.
+  const double g = -ref.model().gravity.z();
+  EXPECT_NEAR(after.twist.linear.z, 3.0 * 20 * dt - g * 40 * dt, 1e-9);
+  EXPECT_NEAR(after.twist.linear.x, 0.1, 1e-12);
+}
+
+TEST(TwinNodeServices, BadRequestsGetErrors_AndTheNodeGoesOn) {
+  ASSERT_TRUE(trigger("pause"));
+  regolith_twin::SetBodyState set;
+  set.request.body = "no_such_body";
+  set.request.pose.orientation.w = 1;
+  ASSERT_TRUE(ros::service::call(srv("set_body_state"), set));
+  EXPECT_FALSE(set.response.success);
+  EXPECT_NE(set.response.message.find("no_such_body"), std::string::npos);
+  set.request.body = "mascot";
+  set.request.pose.orientation.w = 0;  // not a rotation
+  ASSERT_TRUE(ros::service::call(srv("set_body_state"), set));
+  EXPECT_FALSE(set.response.success);
+  set.request.body = "plate";
+  set.request.pose.orientation.w = 1;
+  ASSERT_TRUE(ros::service::call(srv("set_body_state"), set));
+  EXPECT_FALSE(set.response.success) << "a fixed body cannot be moved";
+  regolith_twin::Checkpoint c;
+  c.request.path = "/nonexistent/folder/state.ckpt";
+  ASSERT_TRUE(ros::service::call(srv("load_checkpoint"), c));
+  EXPECT_FALSE(c.response.success);
+  ASSERT_TRUE(ros::service::call(srv("save_checkpoint"), c));
+  EXPECT_FALSE(c.response.success);
+  c.request.path = "/proc/self/status";  // not a checkpoint
+  ASSERT_TRUE(ros::service::call(srv("load_checkpoint"), c));
+  EXPECT_FALSE(c.response.success);
+  regolith_twin::ApplyBodyWrench w;
+  w.request.body = "mascot";
+  w.request.duration = 0;
+  ASSERT_TRUE(ros::service::call(srv("apply_body_wrench"), w));
+  EXPECT_FALSE(w.response.success);
+  w.request.body = "nobody";
+  w.request.duration = 1;
+  ASSERT_TRUE(ros::service::call(srv("apply_body_wrench"), w));
+  EXPECT_FALSE(w.response.success);
+  const double t = g_node->sim_time();
+  const auto r = step(2);
+  EXPECT_TRUE(r.success);
+  EXPECT_GT(r.sim_time, t);
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "twin_node_services_test");
+  ros::NodeHandle nh, pnh("~");
+#ifdef _OPENMP
+  omp_set_num_threads(1);
+#endif
+  ros::AsyncSpinner spinner(3);
+  spinner.start();
+  try {
+    g_params = rt_ros::read_params(pnh);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 1;
+  }
+  g_params.start_paused = true;
+  g_params.threads = 1;
+  g_params.body_state_rate = 0;
+  ros::Subscriber sub = pnh.subscribe("body_states", 1000, on_states);
+  g_node = std::make_unique<rt_ros::TwinNode>(nh, pnh, g_params);
+  g_node->start();
+  ros::WallDuration(0.5).sleep();  // subscriber connected
+  const int rc = RUN_ALL_TESTS();
+  g_node->stop();
+  g_node.reset();
+  ros::shutdown();
+  return rc;
+}

@@ -32,7 +32,8 @@ class RecordReplay(unittest.TestCase):
         os.makedirs(out)
         bag = os.path.join(out, "run.bag")
         rospy.wait_for_service("/twin_node/unpause", timeout=60)
-        rec = subprocess.Popen(["rosbag", "record", "--quiet", "-O", bag] + TOPICS)
+        # Own process group: the rosbag wrapper and its recorder both get the SIGINT.
+        rec = subprocess.Popen(["rosbag", "record", "--quiet", "-O", bag] + TOPICS, start_new_session=True)
         try:
             deadline = time.time() + 30
             while not all(subscribed(t) for t in TOPICS[:3]):
@@ -47,8 +48,11 @@ class RecordReplay(unittest.TestCase):
                 time.sleep(0.2)
             time.sleep(1.0)  # the last messages reach the recorder
         finally:
-            rec.send_signal(signal.SIGINT)
+            os.killpg(rec.pid, signal.SIGINT)
             rec.wait(timeout=30)
+        deadline = time.time() + 30
+        while not os.path.exists(bag) and time.time() < deadline:  # the recorder closes the bag
+            time.sleep(0.2)
         self.assertTrue(os.path.exists(bag), "no bag written")
         tool = roslib.packages.find_node("regolith_twin", "regolith_bag_outcome")
         self.assertTrue(tool, "regolith_bag_outcome not built")

@@ -148,7 +148,8 @@ TwinNode::TwinNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeParams& p)
   paused_ = p_.start_paused;
 
   clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
-  body_pub_ = pnh_.advertise<regolith_twin::BodyStates>("body_states", 100);
+  // A deep queue: body states go out every step, and a recorder must not lose one.
+  body_pub_ = pnh_.advertise<regolith_twin::BodyStates>("body_states", 20000);
   contacts_pub_ = pnh_.advertise<regolith_twin::Contacts>("contacts", 10);
   landing_pub_ = pnh_.advertise<regolith_twin::LandingOutcome>("landing", 10, true);
   status_pub_ = pnh_.advertise<regolith_twin::Status>("status", 10);

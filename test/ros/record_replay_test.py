@@ -9,6 +9,7 @@ import signal
 import subprocess
 import time
 import unittest
+from xmlrpc.client import ServerProxy
 
 import rosgraph
 import roslib.packages
@@ -19,9 +20,15 @@ from std_srvs.srv import Trigger
 TOPICS = ["/twin_node/body_states", "/twin_node/landing", "/twin_node/status", "/tf", "/tf_static"]
 
 
-def subscribed(topic):
-    _, subs, _ = rosgraph.Master("/record_replay").getSystemState()
-    return any(name == topic and nodes for name, nodes in subs)
+def connected(topic):
+    """The node itself has a live outbound connection on topic (not just a
+    subscriber registered with the master)."""
+    try:
+        uri = rosgraph.Master("/record_replay").lookupNode("/twin_node")
+        code, _, info = ServerProxy(uri).getBusInfo("/record_replay")
+    except Exception:
+        return False
+    return code == 1 and any(c[2] == "o" and c[4] == topic and c[5] for c in info)
 
 
 class RecordReplay(unittest.TestCase):
@@ -36,10 +43,9 @@ class RecordReplay(unittest.TestCase):
         rec = subprocess.Popen(["rosbag", "record", "--quiet", "-O", bag] + TOPICS, start_new_session=True)
         try:
             deadline = time.time() + 30
-            while not all(subscribed(t) for t in TOPICS[:3]):
-                self.assertLess(time.time(), deadline, "rosbag did not subscribe")
+            while not all(connected(t) for t in TOPICS[:3]):
+                self.assertLess(time.time(), deadline, "rosbag did not connect")
                 time.sleep(0.1)
-            time.sleep(0.5)
             self.assertTrue(rospy.ServiceProxy("/twin_node/unpause", Trigger)().success)
             summary = os.path.join(out, "summary.json")
             deadline = time.time() + 60

@@ -65,7 +65,7 @@ void Twin::step() {
   if (observer_ && !ended_ && observer_->observe()) {
     ended_ = true;
     final_ = observer_->finish();
-    final_.steps = state_.step;
+    final_.steps = state_.step - start_state_.step;
   }
 }
 

@@ -46,6 +46,12 @@ class RecordReplay(unittest.TestCase):
             while not all(connected(t) for t in TOPICS[:3]):
                 self.assertLess(time.time(), deadline, "rosbag did not connect")
                 time.sleep(0.1)
+            # The recorder opens its bag on the first message (the paused
+            # node's status): unpause only once it is writing.
+            while not os.path.exists(bag + ".active"):
+                self.assertLess(time.time(), deadline, "rosbag did not open the bag")
+                time.sleep(0.1)
+            time.sleep(1.0)
             self.assertTrue(rospy.ServiceProxy("/twin_node/unpause", Trigger)().success)
             summary = os.path.join(out, "summary.json")
             deadline = time.time() + 60
@@ -70,6 +76,7 @@ class RecordReplay(unittest.TestCase):
         with open(replay) as f:
             rep = json.load(f)
         dt = run["run"]["dt"]
+        self.assertGreaterEqual(rep["messages"], run["run"]["steps"], "the recording misses steps of the landing")
         a, b = run["outcome"], rep["outcome"]
         self.assertTrue(a["contact"] and a["lifted_off"], "the test landing must touch down and lift off")
         for key in ("contact", "lifted_off", "ended_by", "cancelled_liftoffs"):

@@ -131,6 +131,7 @@ NodeParams read_params(const ros::NodeHandle& pnh) {
   p.cache_dir = param_text(pnh, "cache_dir", "");
   p.start_paused = param_bool(pnh, "start_paused", false);
   p.shutdown_at_end = param_bool(pnh, "shutdown_at_end", false);
+  p.wait_for_recorder = param_bool(pnh, "wait_for_recorder", false);
   p.threads = int(param_number(pnh, "threads", 0, 0, 256));
   return p;
 }
@@ -145,7 +146,8 @@ TwinNode::TwinNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeParams& p)
   to.landing.cache_dir = p_.cache_dir;
   to.landing.quiet = false;
   twin_ = std::make_unique<rt::Twin>(to);
-  paused_ = p_.start_paused;
+  paused_ = p_.start_paused || p_.wait_for_recorder;
+  waiting_for_recorder_ = p_.wait_for_recorder && !p_.start_paused;
 
   clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
   // A deep queue: body states go out every step, and a recorder must not lose one.
@@ -227,6 +229,22 @@ void TwinNode::loop() {
 #endif
   while (running_ && ros::ok()) {
     std::unique_lock<std::mutex> lk(mu_);
+    if (waiting_for_recorder_ && paused_) {
+      // A recorder is connected once both publishers count a subscriber; the
+      // second of grace lets it open its bag on the paused node's status
+      // messages, so that it has every step from the first.
+      if (body_pub_.getNumSubscribers() > 0 && status_pub_.getNumSubscribers() > 0) {
+        if (!recorder_seen_set_) {
+          recorder_seen_set_ = true;
+          recorder_seen_ = WallClock::now();
+          ROS_INFO("twin_node: recorder connected; starting in 1 s");
+        } else if (WallClock::now() - recorder_seen_ >= std::chrono::seconds(1)) {
+          waiting_for_recorder_ = false;
+          paused_ = false;
+          reset_pacing();
+        }
+      }
+    }
     if ((paused_ || failed_) && pending_steps_ == 0) {
       cv_.wait_for(lk, std::chrono::milliseconds(50));
       // A paused twin keeps /clock and status alive (wall-time throttled).

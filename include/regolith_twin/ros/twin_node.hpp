@@ -45,6 +45,8 @@ struct NodeParams {
   std::string cache_dir;              // ~cache_dir: relaxed beds ("" default)
   bool start_paused = false;          // ~start_paused
   bool shutdown_at_end = false;       // ~shutdown_at_end: stop the node when the landing ends
+  bool wait_for_recorder = false;     // ~wait_for_recorder: start stepping only once ~body_states and
+                                      //   ~status have a subscriber (a rosbag recorder) and 1 s has passed
   int threads = 0;                    // ~threads: OpenMP threads (0: all cores)
 };
 
@@ -120,6 +122,9 @@ class TwinNode {
   long status_step0_ = 0;
   std::string last_phase_;
   bool end_handled_ = false;
+  bool waiting_for_recorder_ = false;
+  WallClock::time_point recorder_seen_{};
+  bool recorder_seen_set_ = false;
 };
 
 }  // namespace rt_ros

@@ -55,7 +55,10 @@ geometry_msgs::Quaternion to_quat(const Quat& q) {
 }
 Vec3 from_vector(const geometry_msgs::Vector3& v) { return Vec3(v.x, v.y, v.z); }
 
-ros::Time stamp(double t) { return ros::Time(std::max(0.0, t)); }
+// Sim time as a ROS stamp. Time zero goes out as 1 ns: ROS takes a zero
+// time for "no clock yet" (rosbag, tf and rospy wait while /clock is 0), and
+// a twin starts paused at t = 0.
+ros::Time stamp(double t) { return t > 0 ? ros::Time(t) : ros::Time(0, 1); }
 
 std::string frame_of(const rt::BodyModel& b, const std::string& link) {
   return b.name + "/" + (link.empty() ? std::string("base") : link);

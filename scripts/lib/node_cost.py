@@ -67,11 +67,21 @@ def main():
             # 2./3. The node, without and with a particles subscriber.
             for label in ("node", "node+pc"):
                 ns = "/cost_%s_%d" % (label.replace("+", "_"), rep)
+                rospy.set_param(ns + "/twin_node/set", sets)  # a list: the command line takes scalars only
                 args = [os.path.join(a.bin, "twin_node"), "__ns:=" + ns, "_scenario_file:=" + a.scenario,
-                        "_start_paused:=true", "_threads:=1", "_set:=%s" % json.dumps(sets)]
+                        "_start_paused:=true", "_threads:=1"]
                 node = subprocess.Popen(args, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
                 try:
-                    rospy.wait_for_service(ns + "/twin_node/step", timeout=300)
+                    deadline = time.time() + 300
+                    while True:
+                        if node.poll() is not None:
+                            sys.exit("node_cost: twin_node exited with code %d" % node.returncode)
+                        try:
+                            rospy.wait_for_service(ns + "/twin_node/step", timeout=1)
+                            break
+                        except rospy.ROSException:
+                            if time.time() > deadline:
+                                sys.exit("node_cost: twin_node did not come up")
                     sub = None
                     if label == "node+pc":
                         received[0] = 0
@@ -101,6 +111,15 @@ def main():
                         ("node+pc", "twin_node, ~particles subscribed (5 Hz)")):
         m = statistics.median(results[label])
         lines.append("| %s | %.1f | %+.1f %% |" % (name, m, 100 * (m / cli - 1)))
+    lines.append("")
+    lines.append("Each repeat (steps/s, in the order run): " + "; ".join(
+        "cli %.1f, node %.1f, node+particles %.1f" % (c, n, p)
+        for c, n, p in zip(results["cli"], results["node"], results["node+pc"])) +
+        ". The spread between repeats of one configuration is the machine's noise.")
+    lines.append("")
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
+                            text=True).stdout.strip() or "unknown"
+    lines.append("Measured on %s at commit %s." % (time.strftime("%Y-%m-%d", time.gmtime()), commit))
     lines.append("")
     lines.append("Scene: %s, first %g s after contact (%d steps, one thread); body states published every step." %
                  (os.path.relpath(a.scenario, ROOT), a.after_contact, steps))

@@ -72,6 +72,17 @@ Energy energy(const Model& m, const State& s) {
   return e;
 }
 
+double kinetic_energy(const Model& m, const State& s) {
+  double e = 0;
+  for (int i = 0; i < m.n_grains; ++i) {
+    if (m.grain_inv_mass[i] == 0) continue;
+    e += 0.5 * m.grain_mass[i] * s.vel[i].squaredNorm() + 0.5 * (1.0 / m.grain_inv_inertia[i]) * s.omega[i].squaredNorm();
+  }
+  for (size_t b = 0; b < m.bodies.size(); ++b)
+    if (!m.bodies[b].fixed) e += body_lin_energy(m.bodies[b], s.bodies[b]) + body_rot_energy(m.bodies[b], s.bodies[b]);
+  return e;
+}
+
 double coordination_number(const Model& m, const State& s) {
   long free_grains = 0;
   for (int i = 0; i < m.n_grains; ++i) free_grains += m.grain_inv_mass[i] != 0;

@@ -606,10 +606,7 @@ void TwinNode::publish_status() {
   msg.frozen_grains = frozen;
   msg.active_grains = uint32_t(m.n_grains) - frozen;
   msg.max_overlap_ratio = s.stats.max_overlap_ratio;
-  double ke = rt::energy(m, s).kinetic();
-  for (size_t b = 0; b < m.bodies.size(); ++b)
-    if (!m.bodies[b].fixed) ke += rt::body_lin_energy(m.bodies[b], s.bodies[b]) + rt::body_rot_energy(m.bodies[b], s.bodies[b]);
-  msg.kinetic_energy = ke;
+  msg.kinetic_energy = rt::kinetic_energy(m, s);
   status_pub_.publish(msg);
   last_status_wall_ = now;
   status_sim0_ = s.time;

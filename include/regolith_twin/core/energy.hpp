@@ -16,6 +16,10 @@ struct Energy {
 
 Energy energy(const Model& m, const State& s);
 
+// Kinetic energy of free grains and bodies alone (no pass over the contact
+// lists), J: what a status display needs at a few hertz.
+double kinetic_energy(const Model& m, const State& s);
+
 // Mean number of grain-grain contacts per free grain (2 * pairs / grains).
 double coordination_number(const Model& m, const State& s);
 

@@ -1,13 +1,11 @@
 // Landing set-up shared by the command-line tools and the ROS node.
 #include "regolith_twin/observe/landing_scene.hpp"
 
-#include <sys/stat.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <sstream>
 
 #include "regolith_twin/observe/runner.hpp"
 #include "regolith_twin/observe/series.hpp"
@@ -56,17 +54,6 @@ std::string bed_key(const Model& m, const State& s, int lander) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
   return buf;
-}
-
-void make_dirs(const std::string& path) {
-  std::string cur;
-  std::stringstream ss(path);
-  if (!path.empty() && path[0] == '/') cur = "/";
-  for (std::string part; std::getline(ss, part, '/');) {
-    if (part.empty()) continue;
-    cur += part + "/";
-    ::mkdir(cur.c_str(), 0755);
-  }
 }
 
 const char* attitude_name(Attitude a) { return a == Attitude::Flat ? "Flat" : a == Attitude::BCF ? "BCF" : "FCF"; }

@@ -2,7 +2,6 @@
 #include "regolith_twin/observe/runner.hpp"
 #include "regolith_twin/scene/snapshot.hpp"
 
-#include <sys/stat.h>
 
 #include <chrono>
 #include <cmath>
@@ -43,18 +42,6 @@ Vec3 group_mean(const std::vector<Vec3>& a, const GrainGroup& g) {
   return c / g.count;
 }
 
-void make_dir(const std::string& dir) {
-  std::string partial;
-  for (size_t i = 0; i <= dir.size(); ++i) {
-    if (i == dir.size() || dir[i] == '/') {
-      if (!partial.empty()) ::mkdir(partial.c_str(), 0755);
-    }
-    if (i < dir.size()) partial += dir[i];
-  }
-  struct stat st {};
-  if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) throw InputError(dir + ": cannot create output folder");
-}
-
 std::string clock_text(double seconds) {
   char b[32];
   const long s = long(seconds + 0.5);
@@ -80,7 +67,7 @@ RunReport run_scenario(Scenario& sc, State& s, const RunOptions& opt) {
   const Model& m = sc.model;
   RunReport rep;
   const bool write = !opt.out_dir.empty();
-  if (write) make_dir(opt.out_dir);
+  if (write) make_dirs(opt.out_dir);
 
   std::vector<const GrainGroup*> tracked;
   for (const auto& g : sc.groups)

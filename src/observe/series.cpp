@@ -1,6 +1,8 @@
 // CSV series and JSON summary writers.
 #include "regolith_twin/observe/series.hpp"
 
+#include <sys/stat.h>
+
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -39,6 +41,16 @@ std::string encode_str(const std::string& s) {
 }
 
 }  // namespace
+
+void make_dirs(const std::string& dir) {
+  std::string partial;
+  for (size_t i = 0; i <= dir.size(); ++i) {
+    if ((i == dir.size() || dir[i] == '/') && !partial.empty()) ::mkdir(partial.c_str(), 0755);
+    if (i < dir.size()) partial += dir[i];
+  }
+  struct stat st {};
+  if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) throw InputError(dir + ": cannot create the folder");
+}
 
 CsvSeries::~CsvSeries() { close(); }
 

@@ -24,6 +24,7 @@
 #include "regolith_twin/Status.h"
 #include "regolith_twin/core/energy.hpp"
 #include "regolith_twin/observe/landing_scene.hpp"
+#include "regolith_twin/observe/series.hpp"
 
 namespace rt_ros {
 namespace {
@@ -300,7 +301,7 @@ void TwinNode::on_end() {
 #ifdef _OPENMP
       threads = omp_get_max_threads();
 #endif
-      ::system(("mkdir -p '" + p_.out_dir + "'").c_str());
+      rt::make_dirs(p_.out_dir);
       rt::write_landing_summary(p_.out_dir + "/summary.json", *ls, o, threads);
       ROS_INFO("twin_node: summary written to %s/summary.json", p_.out_dir.c_str());
     }

@@ -5,13 +5,11 @@
 // gravity with the lander parked away; the relaxed state is cached as an
 // exact checkpoint, so later landings on the same bed start from it
 // bit-identically. Exit codes: 0 done, 2 bad input, 3 numerical blow-up, 1 other.
-#include <sys/stat.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -36,17 +34,6 @@ void usage(std::FILE* f) {
                "  --set k=v     override a key, e.g. --set landing.angle_deg=60 --set landing.attitude=Flat\n"
                "  --cache DIR   where relaxed beds are kept (default $REGOLITH_CACHE or ~/.cache/regolith_twin)\n"
                "  --threads N   OpenMP threads (default: all cores)\n");
-}
-
-void make_dirs(const std::string& path) {
-  std::string cur;
-  std::stringstream ss(path);
-  if (!path.empty() && path[0] == '/') cur = "/";
-  for (std::string part; std::getline(ss, part, '/');) {
-    if (part.empty()) continue;
-    cur += part + "/";
-    ::mkdir(cur.c_str(), 0755);
-  }
 }
 
 }  // namespace
@@ -102,7 +89,7 @@ int main(int argc, char** argv) {
     so.cache_dir = cache;
     so.quiet = quiet;
     if (out.empty()) out = "out/" + rt::load_document(file, overrides)["name"].as<std::string>("scenario");
-    make_dirs(out);
+    rt::make_dirs(out);
     so.relax_out = out + "/bed_relax";
     rt::LandingScene ls = rt::prepare_landing(file, overrides, so);
     rt::State s = ls.start;

@@ -9,6 +9,10 @@
 
 namespace rt {
 
+// Create a folder and its parents (mkdir -p). Throws InputError naming the
+// folder if it does not exist afterwards.
+void make_dirs(const std::string& dir);
+
 class CsvSeries {
  public:
   CsvSeries() = default;

@@ -24,6 +24,22 @@ import matplotlib.pyplot as plt  # noqa: E402
 import rosbag  # noqa: E402
 
 
+def two_panels(series, path, left, right, equal_right=False):
+    """One figure of two panels, each ((x key, label), (y key, label), title), a line per body."""
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
+    for axis, ((xk, xl), (yk, yl), title) in zip(ax, (left, right)):
+        for name, d in series.items():
+            axis.plot(d[xk], d[yk], label=name)
+        axis.set(xlabel=xl, ylabel=yl, title=title)
+        axis.grid(alpha=0.3)
+        axis.legend()
+    if equal_right:
+        ax[1].set_aspect("equal", adjustable="datalim")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("bag")
@@ -65,42 +81,14 @@ def main():
     if not moving:
         sys.exit("plot_bag: %s: no moving body on %s/body_states" % (a.bag, a.ns))
 
-    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
-    for name, d in moving.items():
-        ax[0].plot(d["t"], d["z"], label=name)
-        ax[1].plot(d["x"], d["y"], label=name)
-    ax[0].set(xlabel="sim time (s)", ylabel="centre of mass z (m)", title="height")
-    ax[1].set(xlabel="x (m)", ylabel="y (m)", title="horizontal path")
-    ax[1].set_aspect("equal", adjustable="datalim")
-    for x in ax:
-        x.grid(alpha=0.3)
-        x.legend()
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "trajectory.png"), dpi=110)
-
-    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
-    for name, d in moving.items():
-        ax[0].plot(d["t"], d["v"], label=name)
-        ax[1].plot(d["t"], d["w"], label=name)
-    ax[0].set(xlabel="sim time (s)", ylabel="speed (m/s)", title="centre-of-mass speed")
-    ax[1].set(xlabel="sim time (s)", ylabel="|omega| (rad/s)", title="spin")
-    for x in ax:
-        x.grid(alpha=0.3)
-        x.legend()
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "speed.png"), dpi=110)
-
-    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
-    for name, d in moving.items():
-        ax[0].plot(d["t"], d["f"], label=name)
-        ax[1].plot(d["t"], d["n"], label=name)
-    ax[0].set(xlabel="sim time (s)", ylabel="|F| (N)", title="contact force")
-    ax[1].set(xlabel="sim time (s)", ylabel="points", title="contact points")
-    for x in ax:
-        x.grid(alpha=0.3)
-        x.legend()
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "contacts.png"), dpi=110)
+    t = ("t", "sim time (s)")
+    two_panels(moving, os.path.join(out, "trajectory.png"),
+               (t, ("z", "centre of mass z (m)"), "height"), (("x", "x (m)"), ("y", "y (m)"), "horizontal path"),
+               equal_right=True)
+    two_panels(moving, os.path.join(out, "speed.png"),
+               (t, ("v", "speed (m/s)"), "centre-of-mass speed"), (t, ("w", "|omega| (rad/s)"), "spin"))
+    two_panels(moving, os.path.join(out, "contacts.png"),
+               (t, ("f", "|F| (N)"), "contact force"), (t, ("n", "points"), "contact points"))
 
     lines = ["# Recorded run: %s" % os.path.basename(a.bag), ""]
     any_d = next(iter(moving.values()))

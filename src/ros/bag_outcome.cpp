@@ -8,6 +8,7 @@
 // Exit codes: 0 done, 2 bad input, 4 the recording has gaps (throttled or lost messages).
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
+#include <tf2_eigen/tf2_eigen.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cstdio>
@@ -91,11 +92,14 @@ int main(int argc, char** argv) {
       // The state before the first step (published at start-up) may be fed
       // too: the lander is placed clear of the bed, so it changes nothing.
       rt::BodyState bs;
-      const auto& o = st->pose.orientation;
-      bs.q = (rt::Quat(o.w, o.x, o.y, o.z) * bm.ref_rot).normalized();
-      bs.pos = rt::Vec3(st->center_of_mass.x, st->center_of_mass.y, st->center_of_mass.z);
-      rt::set_body_velocity(bm, bs, rt::Vec3(st->twist.linear.x, st->twist.linear.y, st->twist.linear.z),
-                            rt::Vec3(st->twist.angular.x, st->twist.angular.y, st->twist.angular.z));
+      rt::Quat q_ref;
+      rt::Vec3 v, w;
+      tf2::fromMsg(st->pose.orientation, q_ref);
+      tf2::fromMsg(st->center_of_mass, bs.pos);
+      tf2::fromMsg(st->twist.linear, v);
+      tf2::fromMsg(st->twist.angular, w);
+      bs.q = (q_ref * bm.ref_rot).normalized();
+      rt::set_body_velocity(bm, bs, v, w);
       rt::BodyContacts c;
       c.total = st->contacts;
       c.bed = st->bed_contacts;

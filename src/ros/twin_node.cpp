@@ -6,6 +6,7 @@
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
+#include <tf2_eigen/tf2_eigen.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <algorithm>
@@ -32,29 +33,18 @@ namespace {
 using rt::Quat;
 using rt::Vec3;
 
-geometry_msgs::Point to_point(const Vec3& v) {
-  geometry_msgs::Point p;
-  p.x = v.x();
-  p.y = v.y();
-  p.z = v.z();
-  return p;
-}
+// Eigen <-> message conversions of tf2_eigen, under short names.
+geometry_msgs::Point to_point(const Vec3& v) { return tf2::toMsg(v); }
 geometry_msgs::Vector3 to_vector(const Vec3& v) {
-  geometry_msgs::Vector3 p;
-  p.x = v.x();
-  p.y = v.y();
-  p.z = v.z();
-  return p;
+  geometry_msgs::Vector3 out;
+  return tf2::toMsg(v, out);
 }
-geometry_msgs::Quaternion to_quat(const Quat& q) {
-  geometry_msgs::Quaternion m;
-  m.w = q.w();
-  m.x = q.x();
-  m.y = q.y();
-  m.z = q.z();
-  return m;
+geometry_msgs::Quaternion to_quat(const Quat& q) { return tf2::toMsg(q); }
+Vec3 from_vector(const geometry_msgs::Vector3& v) {
+  Vec3 out;
+  tf2::fromMsg(v, out);
+  return out;
 }
-Vec3 from_vector(const geometry_msgs::Vector3& v) { return Vec3(v.x, v.y, v.z); }
 
 // Sim time as a ROS stamp. Time zero goes out as 1 ns: ROS takes a zero
 // time for "no clock yet" (rosbag, tf and rospy wait while /clock is 0), and

@@ -9,7 +9,6 @@
 
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -17,12 +16,8 @@
 #include <omp.h>
 #endif
 
-#include "regolith_twin/core/energy.hpp"
-#include "regolith_twin/core/step.hpp"
 #include "regolith_twin/observe/landing_scene.hpp"
-#include "regolith_twin/observe/runner.hpp"
 #include "regolith_twin/observe/series.hpp"
-#include "regolith_twin/scene/checkpoint.hpp"
 #include "regolith_twin/scene/scenario.hpp"
 
 namespace {

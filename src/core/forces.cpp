@@ -10,27 +10,8 @@
 #include "regolith_twin/core/contact_law.hpp"
 #include "regolith_twin/core/walls.hpp"
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 namespace rt {
 namespace {
-
-int thread_id() {
-#ifdef _OPENMP
-  return omp_get_thread_num();
-#else
-  return 0;
-#endif
-}
-int thread_count() {
-#ifdef _OPENMP
-  return omp_get_num_threads();
-#else
-  return 1;
-#endif
-}
 
 // Grain–grain contacts of rows [rb, re) into F, T. Arrays are taken as
 // restrict pointers and row i's force is summed locally, so the compiler
@@ -531,35 +512,46 @@ void force_pass(const Model& m, State& s) {
     std::fill(sc.body_torque.begin(), sc.body_torque.end(), Vec3::Zero());
   }
   const bool bodies = !m.bodies.empty();
+  const bool batched = !Resist && !s.log_contacts && !s.scalar_kernel;
   long wall_contacts = 0, body_contacts = 0;
 #pragma omp parallel if (n >= m.parallel_min_grains)
   {
-    const int tid = thread_id(), nt = thread_count();
-    // Grain–grain contacts, one partition at a time per thread.
-    for (int p = tid; p < P; p += nt) {
+    // Grain–grain contacts, one partition at a time; a thread takes the next
+    // partition when it is done (a thread slowed by other work on a shared
+    // machine does fewer), which does not change any result.
+#pragma omp for schedule(dynamic, 1)
+    for (int p = 0; p < P; ++p) {
       ThreadScratch& sc = s.scratch[p];
       Vec3* F = p == 0 ? s.force.data() : sc.force.data();
       Vec3* T = p == 0 ? s.torque.data() : sc.torque.data();
-      const int lo = p == 0 ? 0 : sc.touched_lo, hi = p == 0 ? n : sc.touched_hi;
+      // Partition 0 writes State::force: the part of it beyond its own range
+      // is cleared by the merge below.
+      const int lo = sc.touched_lo, hi = sc.touched_hi;
       std::fill(F + lo, F + hi, Vec3::Zero());
       std::fill(T + lo, T + hi, Vec3::Zero());
       const int rb = s.thread_row_begin[p], re = s.thread_row_begin[p + 1];
-      if (!Resist && !s.log_contacts && !s.scalar_kernel && m.single_grain_material >= 0)
+      if (batched && m.single_grain_material >= 0)
         pair_rows_batched<M, true>(m, s, rb, re, F, T, sc);
-      else if (!Resist && !s.log_contacts && !s.scalar_kernel)
+      else if (batched)
         pair_rows_batched<M, false>(m, s, rb, re, F, T, sc);
       else
         pair_rows<M, Resist>(m, s, s.thread_row_begin[p], s.thread_row_begin[p + 1], F, T, sc);
-    }
-#pragma omp barrier
-    // Merge partition buffers in partition order: each thread takes a block
-    // of grains and adds, partition after partition, the part of each
-    // buffer's written range inside it (every grain still sums in partition
-    // order, whatever the thread count).
-    {
-      const int gb = int(long(n) * tid / nt), ge = int(long(n) * (tid + 1) / nt);
-      Vec3* __restrict force = s.force.data();
-      Vec3* __restrict torque = s.torque.data();
+    }  // (implied barrier)
+    // Merge and walls, one block of grains at a time per thread (block q is
+    // grains [n q/P, n (q+1)/P) and the wall entries of those grains): every
+    // grain sums the partition buffers in partition order, then its wall
+    // contacts in list order, whatever the thread count, and no two threads
+    // write one grain.
+    const int hi0 = s.scratch[0].touched_hi;
+    Vec3* __restrict force = s.force.data();
+    Vec3* __restrict torque = s.torque.data();
+#pragma omp for schedule(dynamic, 1)
+    for (int q = 0; q < P; ++q) {
+      const int gb = int(long(n) * q / P), ge = int(long(n) * (q + 1) / P);
+      if (ge > hi0) {
+        std::fill(force + std::max(gb, hi0), force + ge, Vec3::Zero());
+        std::fill(torque + std::max(gb, hi0), torque + ge, Vec3::Zero());
+      }
       for (int p = 1; p < P; ++p) {
         const ThreadScratch& sc = s.scratch[p];
         const Vec3* __restrict pf = sc.force.data();
@@ -570,21 +562,18 @@ void force_pass(const Model& m, State& s) {
           torque[i] += pt[i];
         }
       }
-    }
-#pragma omp barrier
-    // Wall contacts: partitions split at grain boundaries, so no two write one grain.
-    // Contact counts of walls go to a separate total.
-    for (int p = tid; p < P; p += nt) {
-      ThreadScratch& sc = s.scratch[p];
+      // Contact counts of walls go to a separate total.
+      ThreadScratch& sc = s.scratch[q];
       const long before = sc.contacts;
-      wall_entries<M, Resist>(m, s, s.thread_wall_begin[p], s.thread_wall_begin[p + 1], sc);
+      wall_entries<M, Resist>(m, s, s.thread_wall_begin[q], s.thread_wall_begin[q + 1], sc);
 #pragma omp atomic
       wall_contacts += sc.contacts - before;
     }
+    // (implied barrier)
     if (bodies) {
       // Grain–body contacts, after every wall contact has been added.
-#pragma omp barrier
-      for (int p = tid; p < P; p += nt) {
+#pragma omp for schedule(dynamic, 1)
+      for (int p = 0; p < P; ++p) {
         ThreadScratch& sc = s.scratch[p];
         const long before = sc.contacts;
         body_entries<M, Resist>(m, s, s.thread_body_begin[p], s.thread_body_begin[p + 1], sc);

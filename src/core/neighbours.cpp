@@ -292,15 +292,13 @@ void partition_work(const Model& m, State& s) {
     sc.touched_lo = rb;
     sc.touched_hi = std::min(hi, n);
   }
-  // Wall entries: equal counts, boundaries moved to grain changes.
+  // Wall entries: those of grains [n q/P, n (q+1)/P) form partition q (the
+  // force pass merges that block of grains and adds its wall contacts in one go).
   const WallList& wl = s.wall_pairs;
   s.thread_wall_begin.resize(P + 1);
-  for (int p = 0; p <= P; ++p) {
-    int k = int(long(wl.size()) * p / P);
-    while (k > 0 && k < wl.size() && wl.grain[k] == wl.grain[k - 1]) ++k;
-    s.thread_wall_begin[p] = k;
-  }
-  for (int p = 1; p <= P; ++p) s.thread_wall_begin[p] = std::max(s.thread_wall_begin[p], s.thread_wall_begin[p - 1]);
+  for (int q = 0; q <= P; ++q)
+    s.thread_wall_begin[q] =
+        int(std::lower_bound(wl.grain.begin(), wl.grain.end(), int(long(n) * q / P)) - wl.grain.begin());
 }
 
 bool lists_need_rebuild(const Model& m, const State& s) {

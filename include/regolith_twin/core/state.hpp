@@ -132,7 +132,7 @@ struct State {
 
   // Thread partition of the pair rows, fixed between rebuilds (deterministic).
   std::vector<int> thread_row_begin;  // (n_threads + 1)
-  std::vector<int> thread_wall_begin; // (n_threads + 1) entry split at grain boundaries
+  std::vector<int> thread_wall_begin; // (partitions + 1) wall entries of grains [n q/P, n (q+1)/P)
   std::vector<int> thread_body_begin; // grain–body entries, split at grain boundaries
   std::vector<ThreadScratch> scratch;
 

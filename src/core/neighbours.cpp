@@ -88,42 +88,73 @@ Grid bin_grains(const Model& m, State& s) {
   return g;
 }
 
+// Partners of row i (j > i within the cut-off, ascending) appended to out.
+void row_partners(const Model& m, const State& s, const Grid& g, int i, std::vector<int>& out) {
+  const size_t first = out.size();
+  const Vec3 xi = s.pos[i];
+  const double ri = m.grain_radius[i];
+  const double skin = m.skin;
+  const int c = s.cell_of[i];
+  const int cx = c % g.nx, cy = (c / g.nx) % g.ny, cz = c / (g.nx * g.ny);
+  for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, g.nz - 1); ++z)
+    for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, g.ny - 1); ++y)
+      for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, g.nx - 1); ++x) {
+        const int cc = (z * g.ny + y) * g.nx + x;
+        for (int q = s.cell_start[cc]; q < s.cell_start[cc + 1]; ++q) {
+          const int j = s.cell_items[q];
+          if (j <= i) continue;
+          if (m.grain_fixed[i] && m.grain_fixed[j]) continue;  // glued pairs never interact
+          const double cut = ri + m.grain_radius[j] + skin;
+          if ((s.pos[j] - xi).squaredNorm() < cut * cut) out.push_back(j);
+        }
+      }
+  std::sort(out.begin() + first, out.end());
+}
+
+// Half pair list. Each block of rows [n b/P, n (b+1)/P) is searched into its
+// own buffer (blocks are taken by free threads), then the blocks are copied
+// into place after a prefix sum of the row lengths; every row is built and
+// sorted on its own, so the list is the same for any thread count.
 void build_pairs(const Model& m, State& s, const Grid& g) {
   const int n = m.n_grains;
+  const int P = m.partitions;
   PairList& nl = s.pairs_next;
   nl.row_start.resize(n + 1);
-  nl.partner.clear();
-  const double skin = m.skin;
-  for (int i = 0; i < n; ++i) {
-    nl.row_start[i] = nl.size();
-    const Vec3 xi = s.pos[i];
-    const double ri = m.grain_radius[i];
-    const int c = s.cell_of[i];
-    const int cx = c % g.nx, cy = (c / g.nx) % g.ny, cz = c / (g.nx * g.ny);
-    for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, g.nz - 1); ++z)
-      for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, g.ny - 1); ++y)
-        for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, g.nx - 1); ++x) {
-          const int cc = (z * g.ny + y) * g.nx + x;
-          for (int q = s.cell_start[cc]; q < s.cell_start[cc + 1]; ++q) {
-            const int j = s.cell_items[q];
-            if (j <= i) continue;
-            if (m.grain_fixed[i] && m.grain_fixed[j]) continue;  // glued pairs never interact
-            const double cut = ri + m.grain_radius[j] + skin;
-            if ((s.pos[j] - xi).squaredNorm() < cut * cut) nl.partner.push_back(j);
-          }
-        }
-    std::sort(nl.partner.begin() + nl.row_start[i], nl.partner.end());
-  }
-  nl.row_start[n] = nl.size();
-  size_history(nl, nl.size());
   const PairList& ol = s.pairs;
   const bool have_old = s.lists_valid && static_cast<int>(ol.row_start.size()) == n + 1;
-  for (int i = 0; i < n; ++i) {
-    if (have_old)
-      carry_history(ol, ol.row_start[i], ol.row_start[i + 1], ol.partner, nl, nl.row_start[i], nl.row_start[i + 1],
-                    nl.partner);
-    else
-      carry_history(nl, 0, 0, nl.partner, nl, nl.row_start[i], nl.row_start[i + 1], nl.partner);
+#pragma omp parallel if (n >= m.parallel_min_grains)
+  {
+#pragma omp for schedule(dynamic, 1)
+    for (int b = 0; b < P; ++b) {
+      std::vector<int>& out = s.scratch[b].list_partners;
+      out.clear();
+      const int ib = int(long(n) * b / P), ie = int(long(n) * (b + 1) / P);
+      for (int i = ib; i < ie; ++i) {
+        const size_t before = out.size();
+        row_partners(m, s, g, i, out);
+        nl.row_start[i + 1] = static_cast<int>(out.size() - before);  // row length for now
+      }
+    }
+#pragma omp single
+    {
+      nl.row_start[0] = 0;
+      for (int i = 0; i < n; ++i) nl.row_start[i + 1] += nl.row_start[i];
+      nl.partner.resize(nl.row_start[n]);
+      size_history(nl, nl.size());
+    }  // (implied barrier)
+#pragma omp for schedule(dynamic, 1)
+    for (int b = 0; b < P; ++b) {
+      const std::vector<int>& in = s.scratch[b].list_partners;
+      const int ib = int(long(n) * b / P), ie = int(long(n) * (b + 1) / P);
+      std::copy(in.begin(), in.end(), nl.partner.begin() + nl.row_start[ib]);
+      for (int i = ib; i < ie; ++i) {
+        if (have_old)
+          carry_history(ol, ol.row_start[i], ol.row_start[i + 1], ol.partner, nl, nl.row_start[i],
+                        nl.row_start[i + 1], nl.partner);
+        else
+          carry_history(nl, 0, 0, nl.partner, nl, nl.row_start[i], nl.row_start[i + 1], nl.partner);
+      }
+    }
   }
   std::swap(s.pairs, s.pairs_next);
 }
@@ -270,6 +301,7 @@ void partition_work(const Model& m, State& s) {
   // Per-entry constants of the pair law.
   PairList& pairs = s.pairs;
   pairs.sqrt_mstar.resize(pairs.size());
+#pragma omp parallel for schedule(dynamic, 1024) if (m.n_grains >= m.parallel_min_grains)
   for (int i = 0; i < m.n_grains; ++i)
     for (int k = pairs.row_start[i]; k < pairs.row_start[i + 1]; ++k)
       pairs.sqrt_mstar[k] = std::sqrt(1.0 / (m.grain_inv_mass[i] + m.grain_inv_mass[pairs.partner[k]]));

@@ -1,6 +1,8 @@
 // State construction: every buffer the step needs, sized once.
 #include "regolith_twin/core/state.hpp"
 
+#include <algorithm>
+
 #include "regolith_twin/core/body_collision.hpp"
 
 namespace rt {
@@ -29,6 +31,9 @@ State make_state(const Model& m) {
   }
   // Reserve list storage with head room so rebuilds do not allocate.
   const size_t pair_cap = 16 * size_t(n) + 64, wall_cap = 4 * size_t(n) + 64;
+  // One block of rows of the list build: its share of pair_cap.
+  const size_t block_cap = pair_cap / size_t(std::max(m.partitions, 1)) + 64;
+  for (auto& sc : s.scratch) sc.list_partners.reserve(block_cap);
   for (PairList* l : {&s.pairs, &s.pairs_next}) {
     l->row_start.reserve(n + 1);
     l->partner.reserve(pair_cap);

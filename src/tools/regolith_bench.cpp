@@ -3,7 +3,7 @@
 //                  [--blocks 3] [--block-steps 2000] [--label NAME] [--dump FILE] [--set k=v]...
 // Settles the scene once (cached as a checkpoint), then for each thread count
 // restarts from the settled state and times blocks of steps, printing
-//   RESULT engine=regolith label=L threads=T block=B steps=S seconds=X particle_steps_per_s=P
+//   RESULT engine=regolith label=L threads=T block=B steps=S seconds=X particle_steps_per_s=P cpu_seconds=C rebuilds=R
 // and writes the final state as a LAMMPS-style dump for the physics check.
 #include <sys/stat.h>
 
@@ -112,12 +112,14 @@ int main(int argc, char** argv) {
       for (int b = 1; b <= blocks; ++b) {
         const auto t0 = std::chrono::steady_clock::now();
         const std::clock_t c0 = std::clock();
+        const long rebuilds0 = s.rebuilds;
         for (long k = 0; k < block_steps; ++k) rt::step(m, s);
         const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
         std::printf("RESULT engine=regolith label=%s threads=%d block=%d steps=%ld seconds=%.4f "
-                    "particle_steps_per_s=%.4g cpu_seconds=%.4f\n",
-                    label.c_str(), t, b, block_steps, sec, double(block_steps) * m.n_grains / sec, cpu);
+                    "particle_steps_per_s=%.4g cpu_seconds=%.4f rebuilds=%ld\n",
+                    label.c_str(), t, b, block_steps, sec, double(block_steps) * m.n_grains / sec, cpu,
+                    s.rebuilds - rebuilds0);
         std::fflush(stdout);
       }
     }

@@ -88,6 +88,7 @@ struct ThreadScratch {
   std::vector<ContactRecord> log;  // filled only while State::log_contacts
   std::vector<Vec3> body_force;    // grain–body reaction on each body, N (n_bodies)
   std::vector<Vec3> body_torque;   // about each body's centre of mass, N m
+  std::vector<int> list_partners;  // list build: partners of this block of rows (capacity kept)
 };
 
 struct StepStats {

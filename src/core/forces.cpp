@@ -98,44 +98,53 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec
 // ---------------------------------------------------------------------------
 // Batched grain–grain kernel (no rolling/twisting resistance, no contact log).
 //
-// Rows are walked as in pair_rows, but each touching pair is only gathered
-// into a block of structure-of-arrays records; a full block is evaluated by
-// one branch-free loop over its records, which the compiler vectorises (4
-// pairs per instruction with AVX2 under -march=native, 2 with SSE2 in a
-// portable build; plain C++, no intrinsics), and the results are then added to the force arrays in
-// list order. Every record goes through the same IEEE operations in the same
+// The list entries of a partition are walked in order, and each touching
+// pair only goes into a block as its entry k and grains i, j; a full block
+// is evaluated by one branch-free loop over its records that reads the grain
+// and list arrays by index (the compiler vectorises it, with hardware
+// gathers where the CPU has them: 4 pairs per instruction with AVX2 under
+// -march=native, 2 with SSE2 in a portable build; plain C++, no
+// intrinsics), and the results are then added to the force arrays in list
+// order. Every record goes through the same IEEE operations in the same
 // order as pair_contact (the branches of the spring rotation and of the
 // Coulomb caps become selects), and the sums are formed in the same order as
 // in pair_rows, so both kernels give bit-identical results
 // (test/core/batched_kernel_test.cpp).
 
-constexpr int kBlock = 32;  // records per block: 44 arrays of 32 doubles (11 kB) stay in L1
+constexpr int kBlock = 64;  // records per block
 
 struct alignas(64) ContactBlock {
-  // gathered
-  alignas(64) double dx[kBlock], dy[kBlock], dz[kBlock];   // x_j - x_i
-  alignas(64) double dist2[kBlock], rs[kBlock], ri[kBlock], rj[kBlock], sm[kBlock];
-  alignas(64) double vx[kBlock], vy[kBlock], vz[kBlock];   // v_j - v_i, end of step
-  alignas(64) double wix[kBlock], wiy[kBlock], wiz[kBlock];
-  alignas(64) double wjx[kBlock], wjy[kBlock], wjz[kBlock];
-  alignas(64) double mvx[kBlock], mvy[kBlock], mvz[kBlock];  // v_j - v_i, mid-step
-  alignas(64) double mwix[kBlock], mwiy[kBlock], mwiz[kBlock];
-  alignas(64) double mwjx[kBlock], mwjy[kBlock], mwjz[kBlock];
-  alignas(64) double sx[kBlock], sy[kBlock], sz[kBlock];   // tangential spring (updated in place)
-  alignas(64) double c0[kBlock], c1[kBlock], c2[kBlock], c3[kBlock], mu[kBlock];  // law constants
+  alignas(64) double c0[kBlock], c1[kBlock], c2[kBlock], c3[kBlock], mu[kBlock];  // law constants (not Uniform)
   // results
+  alignas(64) double sx[kBlock], sy[kBlock], sz[kBlock];   // tangential spring after the step
   alignas(64) double fx[kBlock], fy[kBlock], fz[kBlock];   // force on i
   alignas(64) double tix[kBlock], tiy[kBlock], tiz[kBlock];
   alignas(64) double tjx[kBlock], tjy[kBlock], tjz[kBlock];
   alignas(64) double x[kBlock];                            // overlap
-  int k[kBlock], i[kBlock], j[kBlock];
+  alignas(64) double rmin[kBlock];                         // smaller radius
+  int k[kBlock], i[kBlock], j[kBlock];                     // list entry and its grains
+};
+
+// Grain and list arrays the block evaluation reads by index (flat doubles:
+// component d of grain i is at 3 i + d).
+static_assert(sizeof(Vec3) == 3 * sizeof(double), "a Vec3 array is read as 3 doubles a grain");
+inline const double* flat(const std::vector<Vec3>& v) { return reinterpret_cast<const double*>(v.data()); }
+struct GatherSource {
+  const double* __restrict pos;
+  const double* __restrict radius;      // grain i's radius at i
+  const double* __restrict vel;
+  const double* __restrict omega;
+  const double* __restrict vel_mid;
+  const double* __restrict omega_mid;
+  const double* __restrict spring;      // list entry k's tangential spring at 3 k
+  const double* __restrict sqrt_mstar;  // list entry k's sqrt(m*)
 };
 
 // pair_contact<M, false> for records [0, nb) of a block. Law constants:
 // linear c0..c3 = kn, kt, cn_coef, ct_coef; Hertz–Mindlin c0..c2 = E*, G*, hm_damp;
 // per record, or the same for all (Uniform: every grain has one material).
 template <ContactModel M, bool Uniform>
-void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_law) {
+void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_law, const GatherSource& g) {
   const double u0 = M == ContactModel::Linear ? uniform_law.kn : uniform_law.e_star;
   const double u1 = M == ContactModel::Linear ? uniform_law.kt : uniform_law.g_star;
   const double u2 = M == ContactModel::Linear ? uniform_law.cn_coef : uniform_law.hm_damp;
@@ -145,12 +154,23 @@ void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_l
     const double c0 = Uniform ? u0 : b.c0[c], c1 = Uniform ? u1 : b.c1[c], c2 = Uniform ? u2 : b.c2[c],
                  c3 = Uniform ? u3 : b.c3[c], mu = Uniform ? umu : b.mu[c];
     // Geometry (pair_rows).
-    const double dist2 = b.dist2[c];
+    const int gi = 3 * b.i[c], gj = 3 * b.j[c], gk = 3 * b.k[c];
+    const double dx = g.pos[gj] - g.pos[gi], dy = g.pos[gj + 1] - g.pos[gi + 1], dz = g.pos[gj + 2] - g.pos[gi + 2];
+    const double ri = g.radius[b.i[c]], rj = g.radius[b.j[c]];
+    const double rs = ri + rj;
+    const double dist2 = dx * dx + dy * dy + dz * dz;
     const double inv_dist = 1.0 / std::sqrt(dist2);
-    const double nx = b.dx[c] * inv_dist, ny = b.dy[c] * inv_dist, nz = b.dz[c] * inv_dist;
-    const double x = b.rs[c] - dist2 * inv_dist;
-    const double li = b.ri[c] - 0.5 * x, lj = b.rj[c] - 0.5 * x;
-    const double sm = b.sm[c];
+    const double nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
+    const double x = rs - dist2 * inv_dist;
+    const double li = ri - 0.5 * x, lj = rj - 0.5 * x;
+    const double sm = g.sqrt_mstar[b.k[c]];
+    const double vx = g.vel[gj] - g.vel[gi], vy = g.vel[gj + 1] - g.vel[gi + 1], vz = g.vel[gj + 2] - g.vel[gi + 2];
+    const double wix = g.omega[gi], wiy = g.omega[gi + 1], wiz = g.omega[gi + 2];
+    const double wjx = g.omega[gj], wjy = g.omega[gj + 1], wjz = g.omega[gj + 2];
+    const double mvx = g.vel_mid[gj] - g.vel_mid[gi], mvy = g.vel_mid[gj + 1] - g.vel_mid[gi + 1],
+                 mvz = g.vel_mid[gj + 2] - g.vel_mid[gi + 2];
+    const double mwix = g.omega_mid[gi], mwiy = g.omega_mid[gi + 1], mwiz = g.omega_mid[gi + 2];
+    const double mwjx = g.omega_mid[gj], mwjy = g.omega_mid[gj + 1], mwjz = g.omega_mid[gj + 2];
     // law_terms
     double fn_el, kt, cn, ct;
     if constexpr (M == ContactModel::Linear) {
@@ -159,7 +179,7 @@ void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_l
       cn = c2 * sm;
       ct = c3 * sm;
     } else {
-      const double reff = b.ri[c] * b.rj[c] / b.rs[c];
+      const double reff = ri * rj / rs;
       const double a = std::sqrt(reff * x);
       const double kn_eff = 2.0 * c0 * a;
       fn_el = (2.0 / 3.0) * kn_eff * x;
@@ -168,16 +188,16 @@ void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_l
       ct = cn;
     }
     // Contact-point velocities: u = vrel - (lj wj + li wi) x n, normal and tangential parts.
-    const double ax = lj * b.wjx[c] + li * b.wix[c], ay = lj * b.wjy[c] + li * b.wiy[c],
-                 az = lj * b.wjz[c] + li * b.wiz[c];
-    const double ux = b.vx[c] - (ay * nz - az * ny), uy = b.vy[c] - (az * nx - ax * nz),
-                 uz = b.vz[c] - (ax * ny - ay * nx);
+    const double ax = lj * wjx + li * wix, ay = lj * wjy + li * wiy,
+                 az = lj * wjz + li * wiz;
+    const double ux = vx - (ay * nz - az * ny), uy = vy - (az * nx - ax * nz),
+                 uz = vz - (ax * ny - ay * nx);
     const double un = ux * nx + uy * ny + uz * nz;
     const double utx = ux - un * nx, uty = uy - un * ny, utz = uz - un * nz;
-    const double bx = lj * b.mwjx[c] + li * b.mwix[c], by = lj * b.mwjy[c] + li * b.mwiy[c],
-                 bz = lj * b.mwjz[c] + li * b.mwiz[c];
-    const double mx = b.mvx[c] - (by * nz - bz * ny), my = b.mvy[c] - (bz * nx - bx * nz),
-                 mz = b.mvz[c] - (bx * ny - by * nx);
+    const double bx = lj * mwjx + li * mwix, by = lj * mwjy + li * mwiy,
+                 bz = lj * mwjz + li * mwiz;
+    const double mx = mvx - (by * nz - bz * ny), my = mvy - (bz * nx - bx * nz),
+                 mz = mvz - (bx * ny - by * nx);
     const double mn = mx * nx + my * ny + mz * nz;
     const double mtx = mx - mn * nx, mty = my - mn * ny, mtz = mz - mn * nz;
     // Normal force on i and the magnitude used for the friction limit.
@@ -186,7 +206,7 @@ void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_l
     const double fn_arg = fn_el - cn * un;
     const double fn = 0.0 < fn_arg ? fn_arg : 0.0;  // std::max(0.0, fn_arg)
     // detail::rotate_into_plane
-    double sx = b.sx[c], sy = b.sy[c], sz = b.sz[c];
+    double sx = g.spring[gk], sy = g.spring[gk + 1], sz = g.spring[gk + 2];
     {
       const double s2 = sx * sx + sy * sy + sz * sz;
       const double sn = sx * nx + sy * ny + sz * nz;
@@ -238,6 +258,7 @@ void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_l
     b.tjy[c] = lj * qy;
     b.tjz[c] = lj * qz;
     b.x[c] = x;
+    b.rmin[c] = rj < ri ? rj : ri;  // std::min(ri, rj)
   }
 }
 
@@ -252,9 +273,9 @@ struct RowSums {
 
 // Evaluate a block and add its results in list order, as pair_rows does.
 template <ContactModel M, bool Uniform>
-void flush_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_law, PairList& pl, Vec3* __restrict F,
-                 Vec3* __restrict T, RowSums& r) {
-  evaluate_block<M, Uniform>(b, nb, dt, uniform_law);
+void flush_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_law, const GatherSource& g, PairList& pl,
+                 Vec3* __restrict F, Vec3* __restrict T, RowSums& r) {
+  evaluate_block<M, Uniform>(b, nb, dt, uniform_law, g);
   Vec3* __restrict spring = pl.spring_t.data();
   for (int c = 0; c < nb; ++c) {
     spring[b.k[c]] = Vec3(b.sx[c], b.sy[c], b.sz[c]);
@@ -273,7 +294,7 @@ void flush_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_law,
     r.ti += Vec3(b.tix[c], b.tiy[c], b.tiz[c]);
     F[j] -= f;
     T[j] += Vec3(b.tjx[c], b.tjy[c], b.tjz[c]);
-    const double rmin = std::min(b.ri[c], b.rj[c]);
+    const double rmin = b.rmin[c];
     if (b.x[c] > r.max_ratio * rmin) {
       r.max_ratio = b.x[c] / rmin;
       r.max_grain = i;
@@ -289,111 +310,72 @@ void pair_rows_batched(const Model& m, State& s, int rb, int re, Vec3* __restric
   const double dt = m.dt;
   const int nm = m.n_materials();
   const Vec3* __restrict pos = s.pos.data();
-  const Vec3* __restrict vel = s.vel.data();
-  const Vec3* __restrict omega = s.omega.data();
-  const Vec3* __restrict vel_mid = s.vel_mid.data();
-  const Vec3* __restrict omega_mid = s.omega_mid.data();
   const double* __restrict radius = m.grain_radius.data();
   const int* __restrict material = m.grain_material.data();
   const int* __restrict partner = pl.partner.data();
   const int* __restrict row = pl.row_start.data();
+  const int* __restrict owner = pl.owner.data();
   const double* __restrict sqrt_mstar = pl.sqrt_mstar.data();
   uint8_t* __restrict touching = pl.touching.data();
   Vec3* __restrict spring_t = pl.spring_t.data();
+  const GatherSource g{flat(s.pos),     radius,           flat(s.vel), flat(s.omega),
+                       flat(s.vel_mid), flat(s.omega_mid), flat(pl.spring_t), sqrt_mstar};
   ContactBlock b;
   int nb = 0;
   long contacts = 0;
   RowSums r;
   r.max_ratio = sc.max_overlap_ratio;
   r.max_grain = sc.max_overlap_grain;
-  for (int i = rb; i < re; ++i) {
-    const Vec3 xi = pos[i], vi = vel[i], wi = omega[i], vi_mid = vel_mid[i], wi_mid = omega_mid[i];
-    const double ri = radius[i];
-    const PairLaw* laws = &m.pair_law[material[i] * nm];
-    // The row goes in chunks that fit the block. Pass 1 tests the distance
-    // of every entry and appends each touching one without a branch (the
-    // record is written at nb either way, nb advances only when touching),
-    // so the entries that do not touch (1 in 4 in a settled bed) cost no
-    // mispredicted jump; pass 2 gathers the rest of the new records.
-    for (int k0 = row[i], kend_row = row[i + 1]; k0 < kend_row;) {
-      if (nb == kBlock) {
-        flush_block<M, Uniform>(b, nb, dt, uniform_law, pl, F, T, r);
-        nb = 0;
-      }
-      const int kend = std::min(kend_row, k0 + (kBlock - nb));
-      const int nb0 = nb;
-      for (int k = k0; k < kend; ++k) {
-        const int j = partner[k];
-        const Vec3 d = pos[j] - xi;
-        const double rj = radius[j];
-        const double rs = ri + rj;
-        const double dist2 = d.squaredNorm();
-        const bool touch = dist2 < rs * rs;
-        if (touching[k] && !touch) {  // contact ended: its history goes (rare)
-          spring_t[k].setZero();
-          pl.spring_r[k].setZero();
-          pl.spring_w[k] = 0;
-        }
-        touching[k] = touch;
-        b.k[nb] = k;
-        b.j[nb] = j;
-        b.dx[nb] = d.x();
-        b.dy[nb] = d.y();
-        b.dz[nb] = d.z();
-        b.dist2[nb] = dist2;
-        b.rs[nb] = rs;
-        b.rj[nb] = rj;
-        nb += touch;
-      }
-      for (int c = nb0; c < nb; ++c) {
-        const int j = b.j[c], k = b.k[c];
-        b.i[c] = i;
-        b.ri[c] = ri;
-        b.sm[c] = sqrt_mstar[k];
-        const Vec3 v = vel[j] - vi, mv = vel_mid[j] - vi_mid;
-        const Vec3 &wj = omega[j], &mwj = omega_mid[j], &sp = spring_t[k];
-        b.vx[c] = v.x();
-        b.vy[c] = v.y();
-        b.vz[c] = v.z();
-        b.wix[c] = wi.x();
-        b.wiy[c] = wi.y();
-        b.wiz[c] = wi.z();
-        b.wjx[c] = wj.x();
-        b.wjy[c] = wj.y();
-        b.wjz[c] = wj.z();
-        b.mvx[c] = mv.x();
-        b.mvy[c] = mv.y();
-        b.mvz[c] = mv.z();
-        b.mwix[c] = wi_mid.x();
-        b.mwiy[c] = wi_mid.y();
-        b.mwiz[c] = wi_mid.z();
-        b.mwjx[c] = mwj.x();
-        b.mwjy[c] = mwj.y();
-        b.mwjz[c] = mwj.z();
-        b.sx[c] = sp.x();
-        b.sy[c] = sp.y();
-        b.sz[c] = sp.z();
-        if constexpr (!Uniform) {
-          const PairLaw& law = laws[material[j]];
-          if constexpr (M == ContactModel::Linear) {
-            b.c0[c] = law.kn;
-            b.c1[c] = law.kt;
-            b.c2[c] = law.cn_coef;
-            b.c3[c] = law.ct_coef;
-          } else {
-            b.c0[c] = law.e_star;
-            b.c1[c] = law.g_star;
-            b.c2[c] = law.hm_damp;
-            b.c3[c] = 0;
-          }
-          b.mu[c] = law.mu_s;
-        }
-      }
-      contacts += nb - nb0;
-      k0 = kend;
+  // The entries of rows [rb, re) go in chunks that fit the block. The first
+  // loop tests the distance of every entry and appends each touching one
+  // without a branch (the record is written at nb either way, nb advances
+  // only when touching), so the entries that do not touch (1 in 4 in a
+  // settled bed) cost no mispredicted jump, nor do the ends of rows.
+  for (int k0 = row[rb], kend_rows = row[re]; k0 < kend_rows;) {
+    if (nb == kBlock) {
+      flush_block<M, Uniform>(b, nb, dt, uniform_law, g, pl, F, T, r);
+      nb = 0;
     }
+    const int kend = std::min(kend_rows, k0 + (kBlock - nb));
+    const int nb0 = nb;
+    for (int k = k0; k < kend; ++k) {
+      const int i = owner[k], j = partner[k];
+      const Vec3 d = pos[j] - pos[i];
+      const double rs = radius[i] + radius[j];
+      const double dist2 = d.squaredNorm();
+      const bool touch = dist2 < rs * rs;
+      if (touching[k] && !touch) {  // contact ended: its history goes (rare)
+        spring_t[k].setZero();
+        pl.spring_r[k].setZero();
+        pl.spring_w[k] = 0;
+      }
+      touching[k] = touch;
+      b.k[nb] = k;
+      b.i[nb] = i;
+      b.j[nb] = j;
+      nb += touch;
+    }
+    if constexpr (!Uniform) {
+      for (int c = nb0; c < nb; ++c) {
+        const PairLaw& law = m.pair_law[material[b.i[c]] * nm + material[b.j[c]]];
+        if constexpr (M == ContactModel::Linear) {
+          b.c0[c] = law.kn;
+          b.c1[c] = law.kt;
+          b.c2[c] = law.cn_coef;
+          b.c3[c] = law.ct_coef;
+        } else {
+          b.c0[c] = law.e_star;
+          b.c1[c] = law.g_star;
+          b.c2[c] = law.hm_damp;
+          b.c3[c] = 0;
+        }
+        b.mu[c] = law.mu_s;
+      }
+    }
+    contacts += nb - nb0;
+    k0 = kend;
   }
-  if (nb) flush_block<M, Uniform>(b, nb, dt, uniform_law, pl, F, T, r);
+  if (nb) flush_block<M, Uniform>(b, nb, dt, uniform_law, g, pl, F, T, r);
   if (r.i >= 0) {
     F[r.i] += r.fi;
     T[r.i] += r.ti;

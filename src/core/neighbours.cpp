@@ -298,13 +298,16 @@ void build_body_list(const Model& m, State& s) { build_body_grains(m, s); }
 // Split rows into partitions of about equal entry counts; record the grain
 // range each partition writes so merging touches only that range.
 void partition_work(const Model& m, State& s) {
-  // Per-entry constants of the pair law.
+  // Per-entry row owner and constant of the pair law.
   PairList& pairs = s.pairs;
+  pairs.owner.resize(pairs.size());
   pairs.sqrt_mstar.resize(pairs.size());
 #pragma omp parallel for schedule(dynamic, 1024) if (m.n_grains >= m.parallel_min_grains)
   for (int i = 0; i < m.n_grains; ++i)
-    for (int k = pairs.row_start[i]; k < pairs.row_start[i + 1]; ++k)
+    for (int k = pairs.row_start[i]; k < pairs.row_start[i + 1]; ++k) {
+      pairs.owner[k] = i;
       pairs.sqrt_mstar[k] = std::sqrt(1.0 / (m.grain_inv_mass[i] + m.grain_inv_mass[pairs.partner[k]]));
+    }
   const int P = m.partitions;
   const int n = m.n_grains;
   const PairList& pl = s.pairs;

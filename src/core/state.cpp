@@ -37,6 +37,7 @@ State make_state(const Model& m) {
   for (PairList* l : {&s.pairs, &s.pairs_next}) {
     l->row_start.reserve(n + 1);
     l->partner.reserve(pair_cap);
+    l->owner.reserve(pair_cap);
     l->sqrt_mstar.reserve(pair_cap);
     l->spring_t.reserve(pair_cap);
     l->spring_r.reserve(pair_cap);

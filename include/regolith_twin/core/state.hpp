@@ -18,6 +18,7 @@ namespace rt {
 struct PairList {
   std::vector<int> row_start;   // first entry of row i (n_grains + 1)
   std::vector<int> partner;     // j of each entry
+  std::vector<int> owner;       // i of each entry (derived from row_start by partition_work)
   std::vector<double> sqrt_mstar;  // sqrt of the pair's reduced mass, sqrt(kg)
   std::vector<Vec3> spring_t;   // tangential spring S, m (oriented from i to j)
   std::vector<Vec3> spring_r;   // rolling spring delta_R, rad

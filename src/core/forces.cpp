@@ -517,11 +517,13 @@ void force_pass(const Model& m, State& s) {
       ThreadScratch& sc = s.scratch[p];
       Vec3* F = p == 0 ? s.force.data() : sc.force.data();
       Vec3* T = p == 0 ? s.torque.data() : sc.torque.data();
-      // Partition 0 writes State::force: the part of it beyond its own range
-      // is cleared by the merge below.
-      const int lo = sc.touched_lo, hi = sc.touched_hi;
-      std::fill(F + lo, F + hi, Vec3::Zero());
-      std::fill(T + lo, T + hi, Vec3::Zero());
+      // Partition 0 writes State::force, cleared here over its own range
+      // (the rest by the merge below); the other partitions' buffers are
+      // all zero already, as the merge clears what it has read.
+      if (p == 0) {
+        std::fill(F + sc.touched_lo, F + sc.touched_hi, Vec3::Zero());
+        std::fill(T + sc.touched_lo, T + sc.touched_hi, Vec3::Zero());
+      }
       const int rb = s.thread_row_begin[p], re = s.thread_row_begin[p + 1];
       if (batched && m.single_grain_material >= 0)
         pair_rows_batched<M, true>(m, s, rb, re, F, T, sc);
@@ -546,13 +548,15 @@ void force_pass(const Model& m, State& s) {
         std::fill(torque + std::max(gb, hi0), torque + ge, Vec3::Zero());
       }
       for (int p = 1; p < P; ++p) {
-        const ThreadScratch& sc = s.scratch[p];
-        const Vec3* __restrict pf = sc.force.data();
-        const Vec3* __restrict pt = sc.torque.data();
+        ThreadScratch& sc = s.scratch[p];
+        Vec3* __restrict pf = sc.force.data();
+        Vec3* __restrict pt = sc.torque.data();
         const int lo = std::max(gb, sc.touched_lo), hi = std::min(ge, sc.touched_hi);
         for (int i = lo; i < hi; ++i) {
           force[i] += pf[i];
           torque[i] += pt[i];
+          pf[i].setZero();  // ready for the next pass (its writes lie in its touched range)
+          pt[i].setZero();
         }
       }
       // Contact counts of walls go to a separate total.

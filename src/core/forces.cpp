@@ -96,7 +96,8 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec
 }
 
 // ---------------------------------------------------------------------------
-// Batched grain–grain kernel (no rolling/twisting resistance, no contact log).
+// Batched grain–grain kernel (any law, with or without rolling and twisting
+// resistance; not when a contact log is kept).
 //
 // The list entries of a partition are walked in order, and each touching
 // pair only goes into a block as its entry k and grains i, j; a full block
@@ -115,8 +116,11 @@ constexpr int kBlock = 64;  // records per block
 
 struct alignas(64) ContactBlock {
   alignas(64) double c0[kBlock], c1[kBlock], c2[kBlock], c3[kBlock], mu[kBlock];  // law constants (not Uniform)
+  alignas(64) double beta[kBlock], mu_r[kBlock], mu_t[kBlock];  // resistance constants (not Uniform)
+  alignas(64) double rolling[kBlock], twisting[kBlock];   // 1 where the pair type has that resistance (not Uniform)
   // results
   alignas(64) double sx[kBlock], sy[kBlock], sz[kBlock];   // tangential spring after the step
+  alignas(64) double rx[kBlock], ry[kBlock], rz[kBlock], tw[kBlock];  // rolling and twisting springs (Resist)
   alignas(64) double fx[kBlock], fy[kBlock], fz[kBlock];   // force on i
   alignas(64) double tix[kBlock], tiy[kBlock], tiz[kBlock];
   alignas(64) double tjx[kBlock], tjy[kBlock], tjz[kBlock];
@@ -137,18 +141,23 @@ struct GatherSource {
   const double* __restrict vel_mid;
   const double* __restrict omega_mid;
   const double* __restrict spring;      // list entry k's tangential spring at 3 k
+  const double* __restrict spring_r;    // list entry k's rolling spring at 3 k
+  const double* __restrict spring_w;    // list entry k's twisting spring at k
   const double* __restrict sqrt_mstar;  // list entry k's sqrt(m*)
 };
 
-// pair_contact<M, false> for records [0, nb) of a block. Law constants:
+// pair_contact<M, Resist> for records [0, nb) of a block. Law constants:
 // linear c0..c3 = kn, kt, cn_coef, ct_coef; Hertz–Mindlin c0..c2 = E*, G*, hm_damp;
 // per record, or the same for all (Uniform: every grain has one material).
-template <ContactModel M, bool Uniform>
+// With Resist, rolling and twisting resistance as in pair_contact<M, true>.
+template <ContactModel M, bool Uniform, bool Resist>
 void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_law, const GatherSource& g) {
   const double u0 = M == ContactModel::Linear ? uniform_law.kn : uniform_law.e_star;
   const double u1 = M == ContactModel::Linear ? uniform_law.kt : uniform_law.g_star;
   const double u2 = M == ContactModel::Linear ? uniform_law.cn_coef : uniform_law.hm_damp;
   const double u3 = uniform_law.ct_coef, umu = uniform_law.mu_s;
+  const double ubeta = uniform_law.beta, umu_r = uniform_law.mu_r, umu_t = uniform_law.mu_t;
+  const bool uroll = uniform_law.rolling, utwist = uniform_law.twisting;
 #pragma omp simd
   for (int c = 0; c < nb; ++c) {
     const double c0 = Uniform ? u0 : b.c0[c], c1 = Uniform ? u1 : b.c1[c], c2 = Uniform ? u2 : b.c2[c],
@@ -172,16 +181,17 @@ void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_l
     const double mwix = g.omega_mid[gi], mwiy = g.omega_mid[gi + 1], mwiz = g.omega_mid[gi + 2];
     const double mwjx = g.omega_mid[gj], mwjy = g.omega_mid[gj + 1], mwjz = g.omega_mid[gj + 2];
     // law_terms
-    double fn_el, kt, cn, ct;
+    const double reff = ri * rj / rs;  // (Hertz–Mindlin and resistance only)
+    double fn_el, kn_eff, kt, cn, ct;
     if constexpr (M == ContactModel::Linear) {
+      kn_eff = c0;
       fn_el = c0 * x;
       kt = c1;
       cn = c2 * sm;
       ct = c3 * sm;
     } else {
-      const double reff = ri * rj / rs;
       const double a = std::sqrt(reff * x);
-      const double kn_eff = 2.0 * c0 * a;
+      kn_eff = 2.0 * c0 * a;
       fn_el = (2.0 / 3.0) * kn_eff * x;
       kt = 8.0 * c1 * a;
       cn = c2 * std::sqrt(kn_eff) * sm;
@@ -251,12 +261,90 @@ void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_l
     b.fx[c] = fx;
     b.fy[c] = fy;
     b.fz[c] = fz;
-    b.tix[c] = li * qx;
-    b.tiy[c] = li * qy;
-    b.tiz[c] = li * qz;
-    b.tjx[c] = lj * qx;
-    b.tjy[c] = lj * qy;
-    b.tjz[c] = lj * qz;
+    double tix = li * qx, tiy = li * qy, tiz = li * qz;
+    double tjx = lj * qx, tjy = lj * qy, tjz = lj * qz;
+    if constexpr (Resist) {
+      const double beta = Uniform ? ubeta : b.beta[c], mu_r = Uniform ? umu_r : b.mu_r[c],
+                   mu_t = Uniform ? umu_t : b.mu_t[c];
+      const bool rolling = Uniform ? uroll : b.rolling[c] != 0.0, twisting = Uniform ? utwist : b.twisting[c] != 0.0;
+      const double br = beta * reff;
+      const double br2 = br * br;
+      // Relative spin, end of step and mid-step, and its normal (twisting) part.
+      const double wx = wjx - wix, wy = wjy - wiy, wz = wjz - wiz;
+      const double mwx = mwjx - mwix, mwy = mwjy - mwiy, mwz = mwjz - mwiz;
+      const double wn = wx * nx + wy * ny + wz * nz, wn_mid = mwx * nx + mwy * ny + mwz * nz;
+      // Rolling: detail::rotate_into_plane, then detail::slider with
+      // k = kn_eff br^2, c = cn br^2, cap = mu_r br fn.
+      {
+        const double wrx = wx - wn * nx, wry = wy - wn * ny, wrz = wz - wn * nz;
+        const double mrx = mwx - wn_mid * nx, mry = mwy - wn_mid * ny, mrz = mwz - wn_mid * nz;
+        const double r0x = g.spring_r[gk], r0y = g.spring_r[gk + 1], r0z = g.spring_r[gk + 2];
+        double rx = r0x, ry = r0y, rz = r0z;
+        const double s2 = rx * rx + ry * ry + rz * rz;
+        const double sn = rx * nx + ry * ny + rz * nz;
+        const double px = rx - sn * nx, py = ry - sn * ny, pz = rz - sn * nz;
+        const double p2 = s2 - sn * sn;
+        const double gr = std::sqrt(s2 / p2);
+        const bool keep = s2 == 0.0, scale = p2 > 0.0;
+        rx = keep ? rx : scale ? px * gr : px;
+        ry = keep ? ry : scale ? py * gr : py;
+        rz = keep ? rz : scale ? pz * gr : pz;
+        const double k_r = kn_eff * br2, c_r = cn * br2, cap_r = mu_r * br * fn;
+        const double cap_r2 = cap_r * cap_r;
+        rx += mrx * dt;
+        ry += mry * dt;
+        rz += mrz * dt;
+        const double ks2 = k_r * k_r * (rx * rx + ry * ry + rz * rz);
+        const double gs_r = cap_r / std::sqrt(ks2);
+        const bool slip_r = ks2 > cap_r2;
+        rx = slip_r ? rx * gs_r : rx;
+        ry = slip_r ? ry * gs_r : ry;
+        rz = slip_r ? rz * gs_r : rz;
+        double mx = k_r * rx + c_r * wrx, my = k_r * ry + c_r * wry, mz = k_r * rz + c_r * wrz;
+        const double m2 = mx * mx + my * my + mz * mz;
+        const double gm = cap_r / std::sqrt(m2);
+        const bool over_r = m2 > cap_r2;
+        mx = over_r ? mx * gm : mx;
+        my = over_r ? my * gm : my;
+        mz = over_r ? mz * gm : mz;
+        b.rx[c] = rolling ? rx : r0x;
+        b.ry[c] = rolling ? ry : r0y;
+        b.rz[c] = rolling ? rz : r0z;
+        tix = rolling ? tix + mx : tix;
+        tiy = rolling ? tiy + my : tiy;
+        tiz = rolling ? tiz + mz : tiz;
+        tjx = rolling ? tjx - mx : tjx;
+        tjy = rolling ? tjy - my : tjy;
+        tjz = rolling ? tjz - mz : tjz;
+      }
+      // Twisting: detail::slider1 with k = 2 kt br^2, c = 2 ct br^2,
+      // cap = mu_t br mu_s fn.
+      {
+        const double t0 = g.spring_w[b.k[c]];
+        double ts = t0;
+        const double k_t = 2.0 * kt * br2, c_t = 2.0 * ct * br2, cap_t = mu_t * br * mu * fn;
+        ts += wn_mid * dt;
+        const double ks = k_t * std::fabs(ts);
+        const double gt = cap_t / ks;
+        ts = ks > cap_t ? ts * gt : ts;
+        double mt = k_t * ts + c_t * wn;
+        mt = std::fabs(mt) > cap_t ? std::copysign(cap_t, mt) : mt;
+        b.tw[c] = twisting ? ts : t0;
+        const double mtx = mt * nx, mty = mt * ny, mtz = mt * nz;
+        tix = twisting ? tix + mtx : tix;
+        tiy = twisting ? tiy + mty : tiy;
+        tiz = twisting ? tiz + mtz : tiz;
+        tjx = twisting ? tjx - mtx : tjx;
+        tjy = twisting ? tjy - mty : tjy;
+        tjz = twisting ? tjz - mtz : tjz;
+      }
+    }
+    b.tix[c] = tix;
+    b.tiy[c] = tiy;
+    b.tiz[c] = tiz;
+    b.tjx[c] = tjx;
+    b.tjy[c] = tjy;
+    b.tjz[c] = tjz;
     b.x[c] = x;
     b.rmin[c] = rj < ri ? rj : ri;  // std::min(ri, rj)
   }
@@ -272,13 +360,17 @@ struct RowSums {
 };
 
 // Evaluate a block and add its results in list order, as pair_rows does.
-template <ContactModel M, bool Uniform>
+template <ContactModel M, bool Uniform, bool Resist>
 void flush_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_law, const GatherSource& g, PairList& pl,
                  Vec3* __restrict F, Vec3* __restrict T, RowSums& r) {
-  evaluate_block<M, Uniform>(b, nb, dt, uniform_law, g);
+  evaluate_block<M, Uniform, Resist>(b, nb, dt, uniform_law, g);
   Vec3* __restrict spring = pl.spring_t.data();
   for (int c = 0; c < nb; ++c) {
     spring[b.k[c]] = Vec3(b.sx[c], b.sy[c], b.sz[c]);
+    if constexpr (Resist) {
+      pl.spring_r[b.k[c]] = Vec3(b.rx[c], b.ry[c], b.rz[c]);
+      pl.spring_w[b.k[c]] = b.tw[c];
+    }
     const int i = b.i[c], j = b.j[c];
     if (i != r.i) {
       if (r.i >= 0) {
@@ -302,7 +394,7 @@ void flush_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_law,
   }
 }
 
-template <ContactModel M, bool Uniform>
+template <ContactModel M, bool Uniform, bool Resist>
 void pair_rows_batched(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec3* __restrict T,
                        ThreadScratch& sc) {
   PairList& pl = s.pairs;
@@ -319,7 +411,8 @@ void pair_rows_batched(const Model& m, State& s, int rb, int re, Vec3* __restric
   uint8_t* __restrict touching = pl.touching.data();
   Vec3* __restrict spring_t = pl.spring_t.data();
   const GatherSource g{flat(s.pos),     radius,           flat(s.vel), flat(s.omega),
-                       flat(s.vel_mid), flat(s.omega_mid), flat(pl.spring_t), sqrt_mstar};
+                       flat(s.vel_mid), flat(s.omega_mid), flat(pl.spring_t), flat(pl.spring_r),
+                       pl.spring_w.data(),  sqrt_mstar};
   ContactBlock b;
   int nb = 0;
   long contacts = 0;
@@ -333,7 +426,7 @@ void pair_rows_batched(const Model& m, State& s, int rb, int re, Vec3* __restric
   // settled bed) cost no mispredicted jump, nor do the ends of rows.
   for (int k0 = row[rb], kend_rows = row[re]; k0 < kend_rows;) {
     if (nb == kBlock) {
-      flush_block<M, Uniform>(b, nb, dt, uniform_law, g, pl, F, T, r);
+      flush_block<M, Uniform, Resist>(b, nb, dt, uniform_law, g, pl, F, T, r);
       nb = 0;
     }
     const int kend = std::min(kend_rows, k0 + (kBlock - nb));
@@ -370,12 +463,19 @@ void pair_rows_batched(const Model& m, State& s, int rb, int re, Vec3* __restric
           b.c3[c] = 0;
         }
         b.mu[c] = law.mu_s;
+        if constexpr (Resist) {
+          b.beta[c] = law.beta;
+          b.mu_r[c] = law.mu_r;
+          b.mu_t[c] = law.mu_t;
+          b.rolling[c] = law.rolling;
+          b.twisting[c] = law.twisting;
+        }
       }
     }
     contacts += nb - nb0;
     k0 = kend;
   }
-  if (nb) flush_block<M, Uniform>(b, nb, dt, uniform_law, g, pl, F, T, r);
+  if (nb) flush_block<M, Uniform, Resist>(b, nb, dt, uniform_law, g, pl, F, T, r);
   if (r.i >= 0) {
     F[r.i] += r.fi;
     T[r.i] += r.ti;
@@ -505,7 +605,7 @@ void force_pass(const Model& m, State& s) {
     std::fill(sc.body_torque.begin(), sc.body_torque.end(), Vec3::Zero());
   }
   const bool bodies = !m.bodies.empty();
-  const bool batched = !Resist && !s.log_contacts && !s.scalar_kernel;
+  const bool batched = !s.log_contacts && !s.scalar_kernel;
   long wall_contacts = 0, body_contacts = 0;
 #pragma omp parallel if (n >= m.parallel_min_grains)
   {
@@ -526,9 +626,9 @@ void force_pass(const Model& m, State& s) {
       }
       const int rb = s.thread_row_begin[p], re = s.thread_row_begin[p + 1];
       if (batched && m.single_grain_material >= 0)
-        pair_rows_batched<M, true>(m, s, rb, re, F, T, sc);
+        pair_rows_batched<M, true, Resist>(m, s, rb, re, F, T, sc);
       else if (batched)
-        pair_rows_batched<M, false>(m, s, rb, re, F, T, sc);
+        pair_rows_batched<M, false, Resist>(m, s, rb, re, F, T, sc);
       else
         pair_rows<M, Resist>(m, s, s.thread_row_begin[p], s.thread_row_begin[p + 1], F, T, sc);
     }  // (implied barrier)

@@ -1,9 +1,10 @@
-// The batched grain–grain kernel (forces.cpp, used when no pair type has
-// rolling or twisting resistance) must reproduce the one-pair-at-a-time
-// kernel bit for bit: same springs, forces, overlaps and trajectories. One
-// grain material (law constants shared by the whole block) or two (gathered
-// per pair), walls, impacts, contacts that end and list rebuilds; linear and
-// Hertz–Mindlin laws.
+// The batched grain–grain kernel (forces.cpp, used whenever no contact log
+// is kept) must reproduce the one-pair-at-a-time kernel bit for bit: same
+// springs, forces, overlaps and trajectories. One grain material (law
+// constants shared by the whole block) or two (gathered per pair), walls,
+// impacts, contacts that end and list rebuilds; linear and Hertz–Mindlin
+// laws; without and with rolling and twisting resistance (with two
+// materials, some pair types have rolling resistance only).
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -28,7 +29,7 @@ struct Scene {
   rt::State s;
 };
 
-Scene make_scene(rt::ContactModel law, bool two_materials = true) {
+Scene make_scene(rt::ContactModel law, bool two_materials = true, bool resist = false) {
   Scene sc;
   rt::Model& m = sc.m;
   m.contact_model = law;
@@ -39,6 +40,16 @@ Scene make_scene(rt::ContactModel law, bool two_materials = true) {
   for (rt::Material* mat : {&a, &b, &wall}) {
     mat->young = 1e7;
     mat->poisson = 0.25;
+  }
+  if (resist) {  // a–a and a–b pairs: rolling and twisting; b–b pairs: rolling only
+    a.mu_r = 1.05;
+    a.mu_t = 1.3;
+    a.beta = 0.2;
+    b.mu_r = 0.3;
+    b.mu_t = 0;
+    b.beta = 0.5;
+  } else {
+    for (rt::Material* mat : {&a, &b, &wall}) mat->mu_r = mat->mu_t = 0;
   }
   m.materials = {a, b, wall};
   const double L = 0.1;
@@ -80,12 +91,12 @@ bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
 
 // Runs the scene with the batched and with the scalar kernel side by side and
 // compares every evolving quantity after each block of steps.
-void compare_kernels(rt::ContactModel law, bool two_materials, int steps) {
-  Scene batched = make_scene(law, two_materials), scalar = make_scene(law, two_materials);
-  ASSERT_FALSE(batched.m.any_resistance);
+void compare_kernels(rt::ContactModel law, bool two_materials, int steps, bool resist = false) {
+  Scene batched = make_scene(law, two_materials, resist), scalar = make_scene(law, two_materials, resist);
+  ASSERT_EQ(batched.m.any_resistance, resist);
   ASSERT_EQ(batched.m.single_grain_material, two_materials ? -1 : 0);
   scalar.s.scalar_kernel = true;
-  long contacts = 0, capped = 0;
+  long contacts = 0, capped = 0, rolling = 0, twisting = 0;
   for (int k = 1; k <= steps; ++k) {
     rt::step(batched.m, batched.s);
     rt::step(scalar.m, scalar.s);
@@ -98,6 +109,8 @@ void compare_kernels(rt::ContactModel law, bool two_materials, int steps) {
     ASSERT_TRUE(same_bits(batched.s.omega, scalar.s.omega)) << at << ": spins differ";
     ASSERT_TRUE(same_bits(batched.s.pairs.partner, scalar.s.pairs.partner)) << at << ": pair lists differ";
     ASSERT_TRUE(same_bits(batched.s.pairs.spring_t, scalar.s.pairs.spring_t)) << at << ": springs differ";
+    ASSERT_TRUE(same_bits(batched.s.pairs.spring_r, scalar.s.pairs.spring_r)) << at << ": rolling springs differ";
+    ASSERT_TRUE(same_bits(batched.s.pairs.spring_w, scalar.s.pairs.spring_w)) << at << ": twisting springs differ";
     ASSERT_TRUE(same_bits(batched.s.pairs.touching, scalar.s.pairs.touching)) << at << ": contact flags differ";
     ASSERT_EQ(batched.s.stats.contacts, scalar.s.stats.contacts) << at;
     ASSERT_EQ(batched.s.stats.max_overlap_ratio, scalar.s.stats.max_overlap_ratio) << at;
@@ -105,10 +118,18 @@ void compare_kernels(rt::ContactModel law, bool two_materials, int steps) {
     contacts += batched.s.stats.contacts;
     // Contacts with a live tangential spring.
     const rt::PairList& pl = batched.s.pairs;
-    for (int e = 0; e < pl.size(); ++e) capped += pl.touching[e] && pl.spring_t[e].squaredNorm() > 0;
+    for (int e = 0; e < pl.size(); ++e) {
+      capped += pl.touching[e] && pl.spring_t[e].squaredNorm() > 0;
+      rolling += pl.touching[e] && pl.spring_r[e].squaredNorm() > 0;
+      twisting += pl.touching[e] && pl.spring_w[e] != 0;
+    }
   }
   EXPECT_GT(contacts, 1000) << "too few contacts to exercise the kernel";
   EXPECT_GT(capped, 100);
+  if (resist) {
+    EXPECT_GT(rolling, 100);
+    EXPECT_GT(twisting, 100);
+  }
   EXPECT_GT(batched.s.rebuilds, 5);
 }
 
@@ -124,6 +145,18 @@ TEST(BatchedKernel, LinearTwoMaterialsMatchesScalarBitForBit) {
 
 TEST(BatchedKernel, HertzMindlinTwoMaterialsMatchesScalarBitForBit) {
   compare_kernels(rt::ContactModel::HertzMindlin, true, 3000);
+}
+
+TEST(BatchedKernel, LinearResistanceOneMaterialMatchesScalarBitForBit) {
+  compare_kernels(rt::ContactModel::Linear, false, 3000, true);
+}
+
+TEST(BatchedKernel, LinearResistanceTwoMaterialsMatchesScalarBitForBit) {
+  compare_kernels(rt::ContactModel::Linear, true, 3000, true);
+}
+
+TEST(BatchedKernel, HertzMindlinResistanceTwoMaterialsMatchesScalarBitForBit) {
+  compare_kernels(rt::ContactModel::HertzMindlin, true, 3000, true);
 }
 
 TEST(BatchedKernel, TwoThreadsMatchOneThread) {

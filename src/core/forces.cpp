@@ -146,6 +146,51 @@ struct GatherSource {
   const double* __restrict sqrt_mstar;  // list entry k's sqrt(m*)
 };
 
+// detail::rotate_into_plane on one record's spring, with selects for its
+// branches (same operations, same order).
+__attribute__((always_inline)) inline void rotate_into_plane(double& sx, double& sy, double& sz, double nx, double ny,
+                                                             double nz) {
+  const double s2 = sx * sx + sy * sy + sz * sz;
+  const double sn = sx * nx + sy * ny + sz * nz;
+  const double px = sx - sn * nx, py = sy - sn * ny, pz = sz - sn * nz;
+  const double p2 = s2 - sn * sn;
+  const double g = std::sqrt(s2 / p2);
+  const double qx = px * g, qy = py * g, qz = pz * g;
+  const bool keep = s2 == 0.0, scale = p2 > 0.0;
+  sx = keep ? sx : scale ? qx : px;
+  sy = keep ? sy : scale ? qy : py;
+  sz = keep ? sz : scale ? qz : pz;
+}
+
+// detail::slider on one record, with selects for its branches: advances the
+// spring s by the mid-step rate, caps it, and returns in t the capped
+// k s + c rate.
+__attribute__((always_inline)) inline void slider(double& sx, double& sy, double& sz, double mx, double my, double mz,
+                                                  double ux, double uy, double uz, double k, double c, double cap,
+                                                  double dt, double& tx, double& ty, double& tz) {
+  const double cap2 = cap * cap;
+  sx += mx * dt;
+  sy += my * dt;
+  sz += mz * dt;
+  const double ks2 = k * k * (sx * sx + sy * sy + sz * sz);
+  const double gs = cap / std::sqrt(ks2);
+  const double cx = sx * gs, cy = sy * gs, cz = sz * gs;
+  const bool slip = ks2 > cap2;
+  sx = slip ? cx : sx;
+  sy = slip ? cy : sy;
+  sz = slip ? cz : sz;
+  tx = k * sx + c * ux;
+  ty = k * sy + c * uy;
+  tz = k * sz + c * uz;
+  const double f2 = tx * tx + ty * ty + tz * tz;
+  const double gf = cap / std::sqrt(f2);
+  const double lx = tx * gf, ly = ty * gf, lz = tz * gf;
+  const bool over = f2 > cap2;
+  tx = over ? lx : tx;
+  ty = over ? ly : ty;
+  tz = over ? lz : tz;
+}
+
 // pair_contact<M, Resist> for records [0, nb) of a block. Law constants:
 // linear c0..c3 = kn, kt, cn_coef, ct_coef; Hertz–Mindlin c0..c2 = E*, G*, hm_damp;
 // per record, or the same for all (Uniform: every grain has one material).
@@ -215,41 +260,12 @@ void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_l
     double fx = fnn * nx, fy = fnn * ny, fz = fnn * nz;
     const double fn_arg = fn_el - cn * un;
     const double fn = 0.0 < fn_arg ? fn_arg : 0.0;  // std::max(0.0, fn_arg)
-    // detail::rotate_into_plane
+    // Tangential spring: detail::rotate_into_plane, then detail::slider
+    // with k = kt, c = ct, cap = mu_s fn.
     double sx = g.spring[gk], sy = g.spring[gk + 1], sz = g.spring[gk + 2];
-    {
-      const double s2 = sx * sx + sy * sy + sz * sz;
-      const double sn = sx * nx + sy * ny + sz * nz;
-      const double px = sx - sn * nx, py = sy - sn * ny, pz = sz - sn * nz;
-      const double p2 = s2 - sn * sn;
-      const double g = std::sqrt(s2 / p2);
-      const double qx = px * g, qy = py * g, qz = pz * g;
-      const bool keep = s2 == 0.0, scale = p2 > 0.0;
-      sx = keep ? sx : scale ? qx : px;
-      sy = keep ? sy : scale ? qy : py;
-      sz = keep ? sz : scale ? qz : pz;
-    }
-    // detail::slider with k = kt, c = ct, cap = mu_s fn.
-    const double cap = mu * fn;
-    const double cap2 = cap * cap;
-    sx += mtx * dt;
-    sy += mty * dt;
-    sz += mtz * dt;
-    const double ks2 = kt * kt * (sx * sx + sy * sy + sz * sz);
-    const double gs = cap / std::sqrt(ks2);
-    const double cx = sx * gs, cy = sy * gs, cz = sz * gs;
-    const bool slip = ks2 > cap2;
-    sx = slip ? cx : sx;
-    sy = slip ? cy : sy;
-    sz = slip ? cz : sz;
-    double tx = kt * sx + ct * utx, ty = kt * sy + ct * uty, tz = kt * sz + ct * utz;
-    const double f2 = tx * tx + ty * ty + tz * tz;
-    const double gf = cap / std::sqrt(f2);
-    const double lx = tx * gf, ly = ty * gf, lz = tz * gf;
-    const bool over = f2 > cap2;
-    tx = over ? lx : tx;
-    ty = over ? ly : ty;
-    tz = over ? lz : tz;
+    rotate_into_plane(sx, sy, sz, nx, ny, nz);
+    double tx, ty, tz;
+    slider(sx, sy, sz, mtx, mty, mtz, utx, uty, utz, kt, ct, mu * fn, dt, tx, ty, tz);
     b.sx[c] = sx;
     b.sy[c] = sy;
     b.sz[c] = sz;
@@ -280,33 +296,9 @@ void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_l
         const double mrx = mwx - wn_mid * nx, mry = mwy - wn_mid * ny, mrz = mwz - wn_mid * nz;
         const double r0x = g.spring_r[gk], r0y = g.spring_r[gk + 1], r0z = g.spring_r[gk + 2];
         double rx = r0x, ry = r0y, rz = r0z;
-        const double s2 = rx * rx + ry * ry + rz * rz;
-        const double sn = rx * nx + ry * ny + rz * nz;
-        const double px = rx - sn * nx, py = ry - sn * ny, pz = rz - sn * nz;
-        const double p2 = s2 - sn * sn;
-        const double gr = std::sqrt(s2 / p2);
-        const bool keep = s2 == 0.0, scale = p2 > 0.0;
-        rx = keep ? rx : scale ? px * gr : px;
-        ry = keep ? ry : scale ? py * gr : py;
-        rz = keep ? rz : scale ? pz * gr : pz;
-        const double k_r = kn_eff * br2, c_r = cn * br2, cap_r = mu_r * br * fn;
-        const double cap_r2 = cap_r * cap_r;
-        rx += mrx * dt;
-        ry += mry * dt;
-        rz += mrz * dt;
-        const double ks2 = k_r * k_r * (rx * rx + ry * ry + rz * rz);
-        const double gs_r = cap_r / std::sqrt(ks2);
-        const bool slip_r = ks2 > cap_r2;
-        rx = slip_r ? rx * gs_r : rx;
-        ry = slip_r ? ry * gs_r : ry;
-        rz = slip_r ? rz * gs_r : rz;
-        double mx = k_r * rx + c_r * wrx, my = k_r * ry + c_r * wry, mz = k_r * rz + c_r * wrz;
-        const double m2 = mx * mx + my * my + mz * mz;
-        const double gm = cap_r / std::sqrt(m2);
-        const bool over_r = m2 > cap_r2;
-        mx = over_r ? mx * gm : mx;
-        my = over_r ? my * gm : my;
-        mz = over_r ? mz * gm : mz;
+        rotate_into_plane(rx, ry, rz, nx, ny, nz);
+        double mx, my, mz;
+        slider(rx, ry, rz, mrx, mry, mrz, wrx, wry, wrz, kn_eff * br2, cn * br2, mu_r * br * fn, dt, mx, my, mz);
         b.rx[c] = rolling ? rx : r0x;
         b.ry[c] = rolling ? ry : r0y;
         b.rz[c] = rolling ? rz : r0z;
@@ -330,13 +322,13 @@ void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_l
         double mt = k_t * ts + c_t * wn;
         mt = std::fabs(mt) > cap_t ? std::copysign(cap_t, mt) : mt;
         b.tw[c] = twisting ? ts : t0;
-        const double mtx = mt * nx, mty = mt * ny, mtz = mt * nz;
-        tix = twisting ? tix + mtx : tix;
-        tiy = twisting ? tiy + mty : tiy;
-        tiz = twisting ? tiz + mtz : tiz;
-        tjx = twisting ? tjx - mtx : tjx;
-        tjy = twisting ? tjy - mty : tjy;
-        tjz = twisting ? tjz - mtz : tjz;
+        const double wtx = mt * nx, wty = mt * ny, wtz = mt * nz;
+        tix = twisting ? tix + wtx : tix;
+        tiy = twisting ? tiy + wty : tiy;
+        tiz = twisting ? tiz + wtz : tiz;
+        tjx = twisting ? tjx - wtx : tjx;
+        tjy = twisting ? tjy - wty : tjy;
+        tjz = twisting ? tjz - wtz : tjz;
       }
     }
     b.tix[c] = tix;

@@ -162,6 +162,29 @@ __attribute__((always_inline)) inline void rotate_into_plane(double& sx, double&
   sz = keep ? sz : scale ? qz : pz;
 }
 
+// Scales v (whose scaled magnitude squared is m2) to the cap where m2 > cap2.
+__attribute__((always_inline)) inline void scale_to_cap(double& x, double& y, double& z, double m2, double cap,
+                                                        double cap2) {
+  const double g = cap / std::sqrt(m2);
+  const double cx = x * g, cy = y * g, cz = z * g;
+  const bool over = m2 > cap2;
+  x = over ? cx : x;
+  y = over ? cy : y;
+  z = over ? cz : z;
+}
+
+// A resisting moment m on i (and -m on j) where the pair type has it.
+__attribute__((always_inline)) inline void add_moment(bool on, double mx, double my, double mz, double& tix,
+                                                      double& tiy, double& tiz, double& tjx, double& tjy,
+                                                      double& tjz) {
+  tix = on ? tix + mx : tix;
+  tiy = on ? tiy + my : tiy;
+  tiz = on ? tiz + mz : tiz;
+  tjx = on ? tjx - mx : tjx;
+  tjy = on ? tjy - my : tjy;
+  tjz = on ? tjz - mz : tjz;
+}
+
 // detail::slider on one record, with selects for its branches: advances the
 // spring s by the mid-step rate, caps it, and returns in t the capped
 // k s + c rate.
@@ -172,23 +195,11 @@ __attribute__((always_inline)) inline void slider(double& sx, double& sy, double
   sx += mx * dt;
   sy += my * dt;
   sz += mz * dt;
-  const double ks2 = k * k * (sx * sx + sy * sy + sz * sz);
-  const double gs = cap / std::sqrt(ks2);
-  const double cx = sx * gs, cy = sy * gs, cz = sz * gs;
-  const bool slip = ks2 > cap2;
-  sx = slip ? cx : sx;
-  sy = slip ? cy : sy;
-  sz = slip ? cz : sz;
+  scale_to_cap(sx, sy, sz, k * k * (sx * sx + sy * sy + sz * sz), cap, cap2);  // the spring
   tx = k * sx + c * ux;
   ty = k * sy + c * uy;
   tz = k * sz + c * uz;
-  const double f2 = tx * tx + ty * ty + tz * tz;
-  const double gf = cap / std::sqrt(f2);
-  const double lx = tx * gf, ly = ty * gf, lz = tz * gf;
-  const bool over = f2 > cap2;
-  tx = over ? lx : tx;
-  ty = over ? ly : ty;
-  tz = over ? lz : tz;
+  scale_to_cap(tx, ty, tz, tx * tx + ty * ty + tz * tz, cap, cap2);  // spring and dashpot
 }
 
 // pair_contact<M, Resist> for records [0, nb) of a block. Law constants:
@@ -302,12 +313,7 @@ void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_l
         b.rx[c] = rolling ? rx : r0x;
         b.ry[c] = rolling ? ry : r0y;
         b.rz[c] = rolling ? rz : r0z;
-        tix = rolling ? tix + mx : tix;
-        tiy = rolling ? tiy + my : tiy;
-        tiz = rolling ? tiz + mz : tiz;
-        tjx = rolling ? tjx - mx : tjx;
-        tjy = rolling ? tjy - my : tjy;
-        tjz = rolling ? tjz - mz : tjz;
+        add_moment(rolling, mx, my, mz, tix, tiy, tiz, tjx, tjy, tjz);
       }
       // Twisting: detail::slider1 with k = 2 kt br^2, c = 2 ct br^2,
       // cap = mu_t br mu_s fn.
@@ -322,13 +328,7 @@ void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_l
         double mt = k_t * ts + c_t * wn;
         mt = std::fabs(mt) > cap_t ? std::copysign(cap_t, mt) : mt;
         b.tw[c] = twisting ? ts : t0;
-        const double wtx = mt * nx, wty = mt * ny, wtz = mt * nz;
-        tix = twisting ? tix + wtx : tix;
-        tiy = twisting ? tiy + wty : tiy;
-        tiz = twisting ? tiz + wtz : tiz;
-        tjx = twisting ? tjx - wtx : tjx;
-        tjy = twisting ? tjy - wty : tjy;
-        tjz = twisting ? tjz - wtz : tjz;
+        add_moment(twisting, mt * nx, mt * ny, mt * nz, tix, tiy, tiz, tjx, tjy, tjz);
       }
     }
     b.tix[c] = tix;

@@ -162,7 +162,8 @@ __attribute__((always_inline)) inline void rotate_into_plane(double& sx, double&
   sz = keep ? sz : scale ? qz : pz;
 }
 
-// Scales v (whose scaled magnitude squared is m2) to the cap where m2 > cap2.
+// Scales (x, y, z) by cap / sqrt(m2) where m2, the squared magnitude being
+// capped, exceeds cap2 = cap^2.
 __attribute__((always_inline)) inline void scale_to_cap(double& x, double& y, double& z, double m2, double cap,
                                                         double cap2) {
   const double g = cap / std::sqrt(m2);

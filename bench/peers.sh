@@ -28,6 +28,7 @@
 #   check ENGINE           CHECK line of the cached settled state
 #   versions               VERSION lines of both peers
 #   micro                  build and run the OpenMP microbenchmark
+#   triad [MB]             build and run the one-core memory triad (default 18 MB)
 #   all                    bed, versions, settle all, time at 1 and 2 ranks, micro
 # ENGINE is lammps or liggghts.
 #
@@ -241,6 +242,12 @@ cmd_micro() {
   OMP_NUM_THREADS=2 "$B1_CACHE/omp_micro" "${1:-1.0}" 2
 }
 
+cmd_triad() {
+  mkdir -p "$B1_CACHE"
+  g++ -O3 -march=native "$BENCH_DIR/mem_triad.cpp" -o "$B1_CACHE/mem_triad"
+  "$B1_CACHE/mem_triad" "${1:-18}"
+}
+
 cmd_all() {
   cmd_bed
   cmd_versions
@@ -264,6 +271,7 @@ main() {
     check) [[ $# -ge 1 ]] || die "usage: peers.sh check ENGINE"; cmd_check "$1" ;;
     versions) cmd_versions ;;
     micro) cmd_micro "$@" ;;
+    triad) cmd_triad "$@" ;;
     all) cmd_all ;;
     ""|-h|--help|help) sed -n '2,/^$/p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//' ;;
     *) die "unknown command '$cmd' (try: peers.sh help)" ;;

@@ -14,7 +14,7 @@ def parse(path):
     rows = []
     for line in open(path):
         line = line.strip()
-        m = re.match(r"^(RESULT|CHECK|STATE|VERSION|MICRO|SETTLE)\s+(.*)$", line)
+        m = re.match(r"^(RESULT|CHECK|STATE|VERSION|MICRO|SETTLE|TRIAD)\s+(.*)$", line)
         if not m:
             continue
         kv = dict(re.findall(r"(\w+)=(\S+)", m.group(2)))
@@ -58,6 +58,11 @@ def main():
         out.append("")
         out.append(f"Compute-bound OpenMP microbenchmark on this machine: 2 threads / 1 thread = "
                    f"{float(micro[-1]['ratio_2_over_1']):.2f}×.")
+    triad = [r for r in rows if r["_kind"] == "TRIAD" and "gbps" in r]
+    if triad:
+        out.append("")
+        out.append(f"One-core memory triad (bench/mem_triad.cpp) with a working set of {triad[-1]['mb']} MB: "
+                   f"{float(triad[-1]['gbps']):.1f} GB/s.")
     checks = [r for r in rows if r["_kind"] in ("CHECK",)]
     if checks:
         out.append("")

@@ -58,6 +58,29 @@ def main():
         out.append("")
         out.append(f"Compute-bound OpenMP microbenchmark on this machine: 2 threads / 1 thread = "
                    f"{float(micro[-1]['ratio_2_over_1']):.2f}×.")
+    # The throughput targets of B1, judged on this run's medians.
+    verdict = lambda ok: "**met**" if ok else "**not met**"
+    targets = []
+    for peer, goal in (("lammps", 2.0), ("liggghts", 3.5)):
+        for n in (1, 2):
+            a, b = med.get(("regolith", n)), med.get((peer, n))
+            if a and b:
+                targets.append(f"| at least {goal:g}× {peer}, {n} thread{'s' if n > 1 else ''} | {a / b:.2f}× | "
+                               f"{verdict(a / b >= goal)} |")
+    a, b = med.get(("regolith", 1)), med.get(("regolith", 2))
+    if a and b:
+        need = 1.7
+        text = "1.7×"
+        if micro:
+            m = float(micro[-1]["ratio_2_over_1"])
+            need = min(need, 0.9 * m)
+            text = f"1.7× or 90 % of the microbenchmark's {m:.2f}× (= {0.9 * m:.2f}×)"
+        targets.append(f"| 2-thread speed-up at least {text} | {b / a:.2f}× | {verdict(b / a >= need)} |")
+    if targets:
+        out.append("")
+        out.append("| target | this run | |")
+        out.append("|---|---|---|")
+        out.extend(targets)
     triad = [r for r in rows if r["_kind"] == "TRIAD" and "gbps" in r]
     if triad:
         out.append("")

@@ -59,6 +59,8 @@
 #   B1_SETTLE_STEPS  settling steps (default 30000; other values get their
 #                    own cache entry, handy for quick trials)
 #   B1_BLOCK_STEPS   steps per timed block (default 2000)
+#   B1_BLOCKS        timed blocks per run (default 3; scripts/bench runs 1 per
+#                    engine in each of several interleaved rounds)
 #   LMP_BIN          LAMMPS executable (default lmp)
 #   LIGGGHTS_BIN     LIGGGHTS executable (default liggghts)
 #   PYTHON           Python 3 with numpy (default /usr/bin/python3 if present)
@@ -72,6 +74,7 @@ B1_CACHE="${B1_CACHE:-$BENCH_DIR/.cache}"
 B1_BED="${B1_BED:-$BENCH_DIR/b1_bed.data}"
 B1_SETTLE_STEPS="${B1_SETTLE_STEPS:-30000}"
 B1_BLOCK_STEPS="${B1_BLOCK_STEPS:-2000}"
+B1_BLOCKS="${B1_BLOCKS:-3}"
 B1_NATOMS=45000
 LMP_BIN="${LMP_BIN:-lmp}"
 LIGGGHTS_BIN="${LIGGGHTS_BIN:-liggghts}"
@@ -206,11 +209,11 @@ cmd_time() {
   load0="$(cut -d' ' -f1 /proc/loadavg 2>/dev/null || echo nan)"
   run_engine "$engine" "$nranks" "$base.log" \
     -var mode time -var restart "$(settle_restart "$engine")" \
-    -var dumpfile "$base.dump" -var block_steps "$B1_BLOCK_STEPS"
+    -var dumpfile "$base.dump" -var block_steps "$B1_BLOCK_STEPS" -var blocks "$B1_BLOCKS"
   local results
   results="$(parse_loop_times "$engine" "$nranks" "$base.log")"
-  [[ "$(grep -c '^RESULT' <<<"$results")" == 3 ]] \
-    || die "expected 3 timed blocks in $base.log"
+  [[ "$(grep -c '^RESULT' <<<"$results")" == "$B1_BLOCKS" ]] \
+    || die "expected $B1_BLOCKS timed blocks in $base.log"
   load1="$(cut -d' ' -f1 /proc/loadavg 2>/dev/null || echo nan)"
   echo "$results"
   echo "LOAD engine=$engine ranks=$nranks loadavg_before=$load0 loadavg_after=$load1"

@@ -602,10 +602,14 @@ void force_pass(const Model& m, State& s) {
   long wall_contacts = 0, body_contacts = 0;
 #pragma omp parallel if (n >= m.parallel_min_grains)
   {
-    // Grain–grain contacts, one partition at a time; a thread takes the next
-    // partition when it is done (a thread slowed by other work on a shared
-    // machine does fewer), which does not change any result.
-#pragma omp for schedule(dynamic, 1)
+    // Grain–grain contacts, one partition at a time. The schedule is static:
+    // a thread takes the same partitions, the same merge blocks and (in the
+    // integrator) the same grains every step, so its grains' data stay in
+    // its own core's cache; where the two cores share no cache, handing
+    // partitions to whichever thread is free moved every grain's data from
+    // core to core each step and cost a third of the 2-thread rate
+    // (docs/benchmarks.md). No schedule changes any result.
+#pragma omp for schedule(static)
     for (int p = 0; p < P; ++p) {
       ThreadScratch& sc = s.scratch[p];
       Vec3* F = p == 0 ? s.force.data() : sc.force.data();
@@ -633,7 +637,7 @@ void force_pass(const Model& m, State& s) {
     const int hi0 = s.scratch[0].touched_hi;
     Vec3* __restrict force = s.force.data();
     Vec3* __restrict torque = s.torque.data();
-#pragma omp for schedule(dynamic, 1)
+#pragma omp for schedule(static)
     for (int q = 0; q < P; ++q) {
       const int gb = int(long(n) * q / P), ge = int(long(n) * (q + 1) / P);
       if (ge > hi0) {
@@ -662,7 +666,7 @@ void force_pass(const Model& m, State& s) {
     // (implied barrier)
     if (bodies) {
       // Grain–body contacts, after every wall contact has been added.
-#pragma omp for schedule(dynamic, 1)
+#pragma omp for schedule(static)
       for (int p = 0; p < P; ++p) {
         ThreadScratch& sc = s.scratch[p];
         const long before = sc.contacts;

@@ -1,9 +1,9 @@
 // Integrate stage: kick–drift–kick leapfrog (velocity Verlet). The first half
 // also predicts the end-of-step velocities that the contact dashpots see; the
 // springs advance with the mid-step velocities, as the positions do. Per-grain
-// loops are independent, so any thread split gives the same result; threads
-// take blocks of grains as they become free (a thread slowed by other work on
-// a shared machine takes fewer).
+// loops are independent, so any thread split gives the same result; the split
+// is static, so that each thread integrates the grains whose forces it
+// computed (forces.cpp).
 #include "regolith_twin/core/integrate.hpp"
 
 #include <algorithm>
@@ -27,7 +27,7 @@ void kick_drift(const Model& m, State& s, double h, double dt) {
   Vec3* __restrict omega_mid = s.omega_mid.data();
   bool finite = true;
   double max_d2 = s.stats.max_disp2;
-#pragma omp parallel for schedule(dynamic, 1024) reduction(&& : finite) reduction(max : max_d2) if (n >= m.parallel_min_grains)
+#pragma omp parallel for schedule(static) reduction(&& : finite) reduction(max : max_d2) if (n >= m.parallel_min_grains)
   for (int i = 0; i < n; ++i) {
     const double im = inv_mass[i];
     if (im == 0) {  // glued grain
@@ -64,7 +64,7 @@ void finish_kick(const Model& m, State& s, double h) {
   Vec3* __restrict vel = s.vel.data();
   Vec3* __restrict omega = s.omega.data();
   bool finite = true;
-#pragma omp parallel for schedule(dynamic, 1024) reduction(&& : finite) if (n >= m.parallel_min_grains)
+#pragma omp parallel for schedule(static) reduction(&& : finite) if (n >= m.parallel_min_grains)
   for (int i = 0; i < n; ++i) {
     const double im = inv_mass[i];
     if (im == 0) continue;

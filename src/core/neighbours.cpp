@@ -112,7 +112,7 @@ void row_partners(const Model& m, const State& s, const Grid& g, int i, std::vec
 }
 
 // Half pair list. Each block of rows [n b/P, n (b+1)/P) is searched into its
-// own buffer (blocks are taken by free threads), then the blocks are copied
+// own buffer (statically, like the force pass), then the blocks are copied
 // into place after a prefix sum of the row lengths; every row is built and
 // sorted on its own, so the list is the same for any thread count.
 void build_pairs(const Model& m, State& s, const Grid& g) {
@@ -124,7 +124,7 @@ void build_pairs(const Model& m, State& s, const Grid& g) {
   const bool have_old = s.lists_valid && static_cast<int>(ol.row_start.size()) == n + 1;
 #pragma omp parallel if (n >= m.parallel_min_grains)
   {
-#pragma omp for schedule(dynamic, 1)
+#pragma omp for schedule(static)
     for (int b = 0; b < P; ++b) {
       std::vector<int>& out = s.scratch[b].list_partners;
       out.clear();
@@ -142,7 +142,7 @@ void build_pairs(const Model& m, State& s, const Grid& g) {
       nl.partner.resize(nl.row_start[n]);
       size_history(nl, nl.size());
     }  // (implied barrier)
-#pragma omp for schedule(dynamic, 1)
+#pragma omp for schedule(static)
     for (int b = 0; b < P; ++b) {
       const std::vector<int>& in = s.scratch[b].list_partners;
       const int ib = int(long(n) * b / P), ie = int(long(n) * (b + 1) / P);
@@ -302,7 +302,7 @@ void partition_work(const Model& m, State& s) {
   PairList& pairs = s.pairs;
   pairs.owner.resize(pairs.size());
   pairs.sqrt_mstar.resize(pairs.size());
-#pragma omp parallel for schedule(dynamic, 1024) if (m.n_grains >= m.parallel_min_grains)
+#pragma omp parallel for schedule(static) if (m.n_grains >= m.parallel_min_grains)
   for (int i = 0; i < m.n_grains; ++i)
     for (int k = pairs.row_start[i]; k < pairs.row_start[i + 1]; ++k) {
       pairs.owner[k] = i;

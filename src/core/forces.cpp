@@ -603,9 +603,9 @@ void force_pass(const Model& m, State& s) {
 #pragma omp parallel if (n >= m.parallel_min_grains)
   {
     // Grain–grain contacts, one partition at a time. The schedule is static:
-    // a thread takes the same partitions, the same merge blocks and (in the
-    // integrator) the same grains every step, so its grains' data stay in
-    // its own core's cache; where the two cores share no cache, handing
+    // a thread takes the same partitions and merge blocks every step, and
+    // the integrator's static halves nearly coincide with them, so a
+    // thread's grains' data stay in its own core's cache; where the two cores share no cache, handing
     // partitions to whichever thread is free moved every grain's data from
     // core to core each step and cost a third of the 2-thread rate
     // (docs/benchmarks.md). No schedule changes any result.

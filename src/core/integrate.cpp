@@ -2,8 +2,8 @@
 // also predicts the end-of-step velocities that the contact dashpots see; the
 // springs advance with the mid-step velocities, as the positions do. Per-grain
 // loops are independent, so any thread split gives the same result; the split
-// is static, so that each thread integrates the grains whose forces it
-// computed (forces.cpp).
+// is static (contiguous halves at 2 threads), so that each thread integrates
+// nearly the grains whose forces it merged (forces.cpp).
 #include "regolith_twin/core/integrate.hpp"
 
 #include <algorithm>

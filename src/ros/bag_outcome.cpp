@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "regolith_twin/BodyStates.h"
-#include "regolith_twin/observe/landing.hpp"
-#include "regolith_twin/observe/series.hpp"
+#include "regolith_twin/scenes/landing/landing.hpp"
+#include "regolith_twin/run/series.hpp"
 #include "regolith_twin/scene/scenario.hpp"
 
 int main(int argc, char** argv) {

@@ -21,11 +21,9 @@
 
 #include "regolith_twin/BodyStates.h"
 #include "regolith_twin/Contacts.h"
-#include "regolith_twin/LandingOutcome.h"
 #include "regolith_twin/Status.h"
 #include "regolith_twin/core/energy.hpp"
-#include "regolith_twin/observe/landing_scene.hpp"
-#include "regolith_twin/observe/series.hpp"
+#include "regolith_twin/run/series.hpp"
 
 namespace rt_ros {
 namespace {
@@ -45,11 +43,6 @@ Vec3 from_vector(const geometry_msgs::Vector3& v) {
   tf2::fromMsg(v, out);
   return out;
 }
-
-// Sim time as a ROS stamp. Time zero goes out as 1 ns: ROS takes a zero
-// time for "no clock yet" (rosbag, tf and rospy wait while /clock is 0), and
-// a twin starts paused at t = 0.
-ros::Time stamp(double t) { return t > 0 ? ros::Time(t) : ros::Time(0, 1); }
 
 std::string frame_of(const rt::BodyModel& b, const std::string& link) {
   return b.name + "/" + (link.empty() ? std::string("base") : link);
@@ -137,8 +130,8 @@ TwinNode::TwinNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeParams& p)
   rt::TwinOptions to;
   to.file = p_.scenario_file;
   to.overrides = p_.overrides;
-  to.landing.cache_dir = p_.cache_dir;
-  to.landing.quiet = false;
+  to.scene.cache_dir = p_.cache_dir;
+  to.scene.quiet = false;
   twin_ = std::make_unique<rt::Twin>(to);
   paused_ = p_.start_paused || p_.wait_for_recorder;
   waiting_for_recorder_ = p_.wait_for_recorder && !p_.start_paused;
@@ -147,7 +140,6 @@ TwinNode::TwinNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeParams& p)
   // A deep queue: body states go out every step, and a recorder must not lose one.
   body_pub_ = pnh_.advertise<regolith_twin::BodyStates>("body_states", 20000);
   contacts_pub_ = pnh_.advertise<regolith_twin::Contacts>("contacts", 10);
-  landing_pub_ = pnh_.advertise<regolith_twin::LandingOutcome>("landing", 10, true);
   status_pub_ = pnh_.advertise<regolith_twin::Status>("status", 10);
   particles_pub_ = pnh_.advertise<sensor_msgs::PointCloud2>("particles", 2);
   markers_pub_ = pnh_.advertise<visualization_msgs::MarkerArray>("markers", 2, true);
@@ -171,6 +163,7 @@ TwinNode::TwinNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeParams& p)
     ss << f.rdbuf();
     nh_.setParam(b.name + "/robot_description", ss.str());
   }
+  topics_ = make_scene_topics(twin_->kind(), pnh_, *twin_);
   start_wall_ = WallClock::now();
   publish_static();
 }
@@ -276,27 +269,17 @@ void TwinNode::loop() {
 
 void TwinNode::on_end() {
   end_handled_ = true;
-  const rt::LandingScene* ls = twin_->landing_scene();
-  if (ls) {
-    rt::LandingOutcome o = twin_->outcome();
-    if (failed_) {
-      o.status = "blow_up";
-      o.message = failure_;
-    }
-    ROS_INFO("twin_node: landing ended (%s): %s, speed ratio %.3f, collision %.3g s, penetration %.3g m",
-             failed_ ? "blow-up" : o.ended_by.c_str(), o.lifted_off ? "lifted off" : "no lift-off", o.speed_ratio,
-             o.collision_duration, o.max_penetration);
-    if (!p_.out_dir.empty()) {
-      int threads = 0;
+  ROS_INFO("twin_node: run ended%s: %s", failed_ ? " (blow-up)" : "", twin_->result_line().c_str());
+  if (!p_.out_dir.empty()) {
+    int threads = 0;
 #ifdef _OPENMP
-      threads = omp_get_max_threads();
+    threads = omp_get_max_threads();
 #endif
-      rt::make_dirs(p_.out_dir);
-      rt::write_landing_summary(p_.out_dir + "/summary.json", *ls, o, threads);
-      ROS_INFO("twin_node: summary written to %s/summary.json", p_.out_dir.c_str());
-    }
+    rt::make_dirs(p_.out_dir);
+    twin_->write_summary(p_.out_dir + "/summary.json", failed_ ? "blow_up" : "ok", failure_, threads);
+    ROS_INFO("twin_node: summary written to %s/summary.json", p_.out_dir.c_str());
   }
-  publish_landing();
+  topics_->on_end(*twin_);
   paused_ = true;  // stays up for inspection; unpause steps on past the run end
   if (p_.shutdown_at_end) ros::requestShutdown();
 }
@@ -320,11 +303,7 @@ void TwinNode::after_step(bool force) {
     last_contacts_sim_ = t;
     publish_contacts();
   }
-  if (twin_->is_landing()) {
-    const std::string phase = twin_->phase();
-    if (clock_due || phase != last_phase_) publish_landing();
-    last_phase_ = phase;
-  }
+  topics_->after_step(*twin_, clock_due, force);
   if (force || std::chrono::duration<double>(now - last_status_wall_).count() >= 1.0 / p_.status_rate)
     publish_status();
   const double vis_now = p_.visual_sim_clock ? t : std::chrono::duration<double>(now - start_wall_).count();
@@ -548,34 +527,6 @@ void TwinNode::publish_contacts() {
   contact_markers_pub_.publish(arr);
 }
 
-void TwinNode::publish_landing() {
-  if (!twin_->is_landing()) return;
-  const rt::LandingOutcome o = twin_->outcome();
-  regolith_twin::LandingOutcome msg;
-  msg.header.stamp = stamp(twin_->state().time);
-  msg.phase = twin_->phase();
-  msg.ended_by = o.ended_by;
-  msg.contact = o.contact;
-  msg.lifted_off = o.lifted_off;
-  msg.cancelled_liftoffs = o.relandings;
-  msg.t_contact = o.t_contact;
-  msg.t_liftoff = o.t_liftoff;
-  msg.v_in = o.v_in;
-  msg.v_out = o.v_out;
-  msg.speed_ratio = o.speed_ratio;
-  msg.energy_ratio = o.energy_ratio;
-  msg.angle_out_deg = o.angle_out_deg;
-  msg.spin_out = o.spin_out;
-  msg.collision_duration = o.collision_duration;
-  msg.max_penetration = o.max_penetration;
-  msg.travel_distance = o.travel_distance;
-  msg.travel_time = o.travel_time;
-  msg.ejected_volume = o.ejected_volume;
-  msg.ejected_grains = o.ejected_grains;
-  msg.lowest_corner = twin_->lowest_corner();
-  landing_pub_.publish(msg);
-}
-
 void TwinNode::publish_status() {
   const rt::Model& m = twin_->model();
   const rt::State& s = twin_->state();
@@ -713,20 +664,8 @@ void TwinNode::publish_markers() {
     for (auto& mk : lists)
       if (!mk.points.empty()) arr.markers.push_back(mk);
   }
-  // Landing outcome as text above the bed.
-  if (twin_->is_landing()) {
-    const rt::LandingOutcome o = twin_->outcome();
-    auto mk = base("outcome", visualization_msgs::Marker::TEXT_VIEW_FACING);
-    const rt::LandingSpec& sp = twin_->landing_scene()->run_spec;
-    mk.pose.position = to_point(Vec3(0, 0, sp.rim + 0.6));
-    mk.scale.z = 0.06;
-    mk.color.r = mk.color.g = mk.color.b = 1.0f;
-    char text[256];
-    std::snprintf(text, sizeof text, "t = %.2f s  %s  penetration %.1f cm  speed ratio %.3f", s.time, twin_->phase(),
-                  100 * o.max_penetration, o.speed_ratio);
-    mk.text = text;
-    arr.markers.push_back(mk);
-  }
+  // The scene kind's own markers.
+  topics_->markers(*twin_, base, arr);
   markers_pub_.publish(arr);
 }
 
@@ -785,7 +724,6 @@ bool TwinNode::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response
   failed_ = false;
   failure_.clear();
   end_handled_ = false;
-  last_phase_.clear();
   last_clock_sim_ = last_body_sim_ = last_contacts_sim_ = -1e300;
   reset_pacing();
   after_step(true);

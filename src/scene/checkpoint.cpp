@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "regolith_twin/core/hash.hpp"
 #include "regolith_twin/core/neighbours.hpp"
 
 namespace rt {
@@ -16,14 +17,6 @@ namespace {
 
 constexpr char kMagic[8] = {'R', 'G', 'T', 'W', 'C', 'K', 'P', 'T'};
 constexpr uint32_t kVersion = 3;  // 3: rigid bodies; 2 (grains only) is still read
-
-uint64_t fnv1a(const char* p, size_t n, uint64_t h = 1469598103934665603ULL) {
-  for (size_t i = 0; i < n; ++i) {
-    h ^= static_cast<unsigned char>(p[i]);
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
 
 // Fingerprint of the static grain description a state belongs to.
 uint64_t model_fingerprint(const Model& m) {

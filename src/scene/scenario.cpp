@@ -555,8 +555,7 @@ bool material_preset(const std::string& name, Material& out) {
   return true;
 }
 
-int remove_grains(Scenario& sc, State& s, const std::vector<uint8_t>& drop) {
-  Model& m = sc.model;
+int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vector<GrainGroup>& groups) {
   const int n = m.n_grains;
   std::vector<int> keep;
   for (int i = 0; i < n; ++i)
@@ -579,7 +578,7 @@ int remove_grains(Scenario& sc, State& s, const std::vector<uint8_t>& drop) {
   ns.step = s.step;
   ns.bodies = s.bodies;
   ns.wall_on = s.wall_on;
-  for (GrainGroup& g : sc.groups) {
+  for (GrainGroup& g : groups) {
     const int first = int(std::lower_bound(keep.begin(), keep.end(), g.first) - keep.begin());
     const int last = int(std::lower_bound(keep.begin(), keep.end(), g.first + g.count) - keep.begin());
     g.first = first;
@@ -589,6 +588,10 @@ int remove_grains(Scenario& sc, State& s, const std::vector<uint8_t>& drop) {
   m = std::move(nm);
   s = std::move(ns);
   return removed;
+}
+
+int remove_grains(Scenario& sc, State& s, const std::vector<uint8_t>& drop) {
+  return remove_grains(sc.model, s, drop, sc.groups);
 }
 
 const GrainGroup* Scenario::group(const std::string& n) const {

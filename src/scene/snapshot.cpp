@@ -1,6 +1,8 @@
 // Compact float32 bed snapshots (see snapshot.hpp).
 #include "regolith_twin/scene/snapshot.hpp"
 
+#include "regolith_twin/core/hash.hpp"
+
 #include <unistd.h>
 
 #include <cstdio>
@@ -11,15 +13,6 @@ namespace rt {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'G', 'T', 'W', 'B', 'E', 'D', '1'};
-
-uint64_t fnv1a(const char* p, size_t n) {
-  uint64_t h = 1469598103934665603ULL;
-  for (size_t i = 0; i < n; ++i) {
-    h ^= static_cast<unsigned char>(p[i]);
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
 
 }  // namespace
 

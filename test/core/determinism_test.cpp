@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "regolith_twin/core/hash.hpp"
 #include "regolith_twin/core/walls.hpp"
 #include "regolith_twin/scene/generate.hpp"
 #include "regolith_twin/scene/scenario.hpp"
@@ -81,14 +82,8 @@ Scene make_scene() {
 
 // FNV-1a over the raw bytes of every evolving quantity.
 struct Hasher {
-  uint64_t h = 1469598103934665603ull;
-  void bytes(const void* p, size_t n) {
-    const unsigned char* c = static_cast<const unsigned char*>(p);
-    for (size_t k = 0; k < n; ++k) {
-      h ^= c[k];
-      h *= 1099511628211ull;
-    }
-  }
+  uint64_t h = rt::kFnvOffset;
+  void bytes(const void* p, size_t n) { h = rt::fnv1a(p, n, h); }
   template <class T>
   void vec(const std::vector<T>& v) {
     const size_t n = v.size();

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 
-#include "regolith_twin/observe/landing.hpp"
+#include "regolith_twin/scenes/landing/landing.hpp"
 #include "test_support.hpp"
 
 namespace {

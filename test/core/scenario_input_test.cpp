@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "regolith_twin/observe/runner.hpp"
+#include "regolith_twin/scenes/scenario/scenario_scene.hpp"
 #include "regolith_twin/scene/scenario.hpp"
 #include "test_support.hpp"
 

@@ -1,13 +1,14 @@
 // rt::Twin, the ROS-free running twin under the node: stepping it to the end
-// of a landing gives exactly the outcome of run_landing (the CLI path) from
-// the same prepared scene, and reset and checkpoints restore states exactly.
+// of a landing gives exactly the outcome of run_scene (the CLI path) from the
+// same prepared scene, and reset and checkpoints restore states exactly.
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <string>
 #include <unistd.h>
 
-#include "regolith_twin/observe/twin.hpp"
+#include "regolith_twin/run/twin.hpp"
+#include "regolith_twin/scenes/landing/landing_scene.hpp"
 
 namespace {
 
@@ -16,8 +17,8 @@ const char* kFile = "test/ros/plate_landing.yaml";  // tests run in the source r
 rt::TwinOptions options() {
   rt::TwinOptions o;
   o.file = kFile;
-  o.landing.quiet = true;
-  o.landing.cache_dir = "/tmp/regolith_twin_twin_test_cache_" + std::to_string(::getpid());
+  o.scene.quiet = true;
+  o.scene.cache_dir = "/tmp/regolith_twin_twin_test_cache_" + std::to_string(::getpid());
   return o;
 }
 
@@ -25,16 +26,21 @@ rt::TwinOptions options() {
 
 TEST(Twin, SteppedLandingEqualsRunLanding) {
   rt::Twin twin(options());
-  ASSERT_TRUE(twin.is_landing());
+  ASSERT_EQ(twin.kind(), "landing");
   long guard = 0;
   while (!twin.ended() && ++guard < 100000) twin.step();
   ASSERT_TRUE(twin.ended());
-  const rt::LandingOutcome a = twin.outcome();
+  const auto& run = dynamic_cast<const rt::LandingRun&>(twin.run());
+  const rt::LandingOutcome a = run.outcome(twin.report(), true);
 
-  rt::LandingSetupOptions so = options().landing;
-  rt::LandingScene ls = rt::prepare_landing(kFile, {}, so);
-  rt::State s = ls.start;
-  const rt::LandingOutcome b = rt::run_landing(ls.sc.model, s, ls.lander, ls.run_spec, rt::LandingOptions{"", 0});
+  std::unique_ptr<rt::Scene> scene = rt::load_scene(kFile, {}, options().scene);
+  rt::Model m = scene->sc.model;
+  rt::State s = scene->start;
+  std::unique_ptr<rt::SceneRun> sr;
+  rt::SceneRunOptions ro;
+  ro.progress_every = 0;
+  const rt::RunReport rep = rt::run_scene(*scene, m, s, ro, &sr);
+  const rt::LandingOutcome b = dynamic_cast<const rt::LandingRun&>(*sr).outcome(rep, true);
   EXPECT_TRUE(b.contact && b.lifted_off) << "the test landing must touch down and lift off";
   EXPECT_EQ(a.ended_by, b.ended_by);
   EXPECT_EQ(a.t_contact, b.t_contact);
@@ -45,12 +51,14 @@ TEST(Twin, SteppedLandingEqualsRunLanding) {
   EXPECT_EQ(a.max_penetration, b.max_penetration);
   EXPECT_EQ(a.travel_distance, b.travel_distance);
   EXPECT_EQ(a.steps, b.steps);
-  EXPECT_STREQ(twin.phase(), "ended");
+  EXPECT_STREQ(run.phase(twin.ended()), "ended");
+  EXPECT_EQ(a.far_field_rms, b.far_field_rms);
+  EXPECT_EQ(a.ejected_grains, b.ejected_grains);
 }
 
 TEST(Twin, ResetAndCheckpointsRestoreExactly) {
   rt::Twin twin(options());
-  const int b = twin.lander();
+  const int b = static_cast<const rt::LandingScene&>(twin.scene()).lander;
   const rt::Vec3 p0 = twin.state().bodies[b].pos;
   for (int k = 0; k < 150; ++k) twin.step();
   const std::string path = "/tmp/regolith_twin_twin_test_" + std::to_string(::getpid()) + ".ckpt";

@@ -68,7 +68,7 @@ regolith_twin::Step::Response step(long n) {
 rt::Twin reference_twin() {
   rt::TwinOptions to;
   to.file = g_params.scenario_file;
-  to.landing.quiet = true;
+  to.scene.quiet = true;
   return rt::Twin(to);
 }
 

@@ -1,7 +1,8 @@
-// The ROS adapter over rt::Twin (ROS.md): owns /clock, publishes tf, body
-// states, contacts, the landing outcome, particles, markers, status and
-// diagnostics, and serves pause / unpause / reset / step / checkpoints /
-// body state / wrench. The simulation runs in its own thread; service
+// The ROS adapter over rt::Twin (docs/ros.md): owns /clock, publishes tf,
+// body states, contacts, particles, markers, status and diagnostics, and
+// serves pause / unpause / reset / step / checkpoints / body state / wrench.
+// It knows no scene kind: the kind's own topics (the landing outcome, ...)
+// come from the scene-topics registry (scene_topics.hpp). The simulation runs in its own thread; service
 // callbacks take the same lock, so a request always sees a whole step.
 #pragma once
 
@@ -24,7 +25,8 @@
 #include "regolith_twin/Checkpoint.h"
 #include "regolith_twin/SetBodyState.h"
 #include "regolith_twin/Step.h"
-#include "regolith_twin/observe/twin.hpp"
+#include "regolith_twin/ros/scene_topics.hpp"
+#include "regolith_twin/run/twin.hpp"
 
 namespace rt_ros {
 
@@ -41,10 +43,10 @@ struct NodeParams {
   double markers_rate = 1;            // ~markers_rate: Hz (wall, or sim with visual_clock=sim)
   bool visual_sim_clock = false;      // ~visual_clock: "wall" (live) or "sim" (recording)
   int max_contact_points = 32;        // ~max_contact_points: points listed per pair (the deepest)
-  std::string out_dir;                // ~out_dir: landing summary.json written here at the run end ("" none)
+  std::string out_dir;                // ~out_dir: the run's summary.json written here at the run end ("" none)
   std::string cache_dir;              // ~cache_dir: relaxed beds ("" default)
   bool start_paused = false;          // ~start_paused
-  bool shutdown_at_end = false;       // ~shutdown_at_end: stop the node when the landing ends
+  bool shutdown_at_end = false;       // ~shutdown_at_end: stop the node when the run ends
   bool wait_for_recorder = false;     // ~wait_for_recorder: start stepping only once ~body_states and
                                       //   ~status have a subscriber (a rosbag recorder) and 1 s has passed
   int threads = 0;                    // ~threads: OpenMP threads (0: all cores)
@@ -77,7 +79,6 @@ class TwinNode {
   void publish_static();
   void publish_body_states();
   void publish_contacts();
-  void publish_landing();
   void publish_status();
   void publish_particles();
   void publish_markers();
@@ -96,6 +97,7 @@ class TwinNode {
   ros::NodeHandle nh_, pnh_;
   NodeParams p_;
   std::unique_ptr<rt::Twin> twin_;
+  std::unique_ptr<SceneTopics> topics_;  // the scene kind's own topics
   std::mutex mu_;
   std::condition_variable cv_;       // wakes the loop (unpause, step request, stop)
   std::condition_variable step_cv_;  // wakes a step request when its steps are done
@@ -106,7 +108,7 @@ class TwinNode {
   std::atomic<bool> running_{false};
   std::thread thread_;
 
-  ros::Publisher clock_pub_, body_pub_, contacts_pub_, landing_pub_, status_pub_, particles_pub_, markers_pub_,
+  ros::Publisher clock_pub_, body_pub_, contacts_pub_, status_pub_, particles_pub_, markers_pub_,
       contact_markers_pub_, diag_pub_;
   std::vector<ros::ServiceServer> services_;
   tf2_ros::TransformBroadcaster tf_;
@@ -120,7 +122,6 @@ class TwinNode {
   double pace_sim0_ = 0;
   double status_sim0_ = 0;
   long status_step0_ = 0;
-  std::string last_phase_;
   bool end_handled_ = false;
   bool waiting_for_recorder_ = false;
   WallClock::time_point recorder_seen_{};

@@ -86,6 +86,7 @@ Scenario parse_scenario_text(const std::string& yaml_text, const std::string& so
 // state (kinematics kept; contact lists rebuilt at the next step, so springs
 // start afresh). Grain groups shrink accordingly. Returns the number removed.
 int remove_grains(Scenario& sc, State& s, const std::vector<uint8_t>& drop);
+int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vector<GrainGroup>& groups);
 
 // Published materials (MODEL.md §9): gravel, moderate, glass_beads, glass_beads_b.
 bool material_preset(const std::string& name, Material& out);

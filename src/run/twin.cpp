@@ -1,9 +1,5 @@
 // A running twin (see twin.hpp).
-#include "regolith_twin/observe/twin.hpp"
-
-#include <yaml-cpp/yaml.h>
-
-#include <limits>
+#include "regolith_twin/run/twin.hpp"
 
 #include "regolith_twin/core/step.hpp"
 #include "regolith_twin/scene/checkpoint.hpp"
@@ -11,37 +7,33 @@
 namespace rt {
 
 Twin::Twin(const TwinOptions& opt) : file_(opt.file) {
-  const YAML::Node root = load_document(opt.file, opt.overrides);
-  if (root["landing"]) {
-    landing_ = std::make_unique<LandingScene>(prepare_landing(opt.file, opt.overrides, opt.landing));
-    start_model_ = landing_->sc.model;
-    start_state_ = landing_->start;
-    name_ = landing_->sc.name;
-  } else {
-    Scenario sc = parse_scenario(root, opt.file);
-    start_model_ = sc.model;
-    start_state_ = sc.initial;
-    name_ = sc.name;
-  }
+  scene_ = load_scene(opt.file, opt.overrides, opt.scene);
   reset();
 }
 
 Twin::~Twin() = default;
 
 void Twin::reset() {
-  observer_.reset();
-  model_ = start_model_;
-  state_ = start_state_;
+  scene_run_.reset();
+  run_.reset();
+  model_ = scene_->sc.model;
+  state_ = scene_->start;
   wrench_until_.clear();
-  restart_observer();
+  restart_run();
 }
 
-void Twin::restart_observer() {
-  observer_.reset();
-  ended_ = false;
-  final_ = LandingOutcome();
-  if (landing_) observer_ = std::make_unique<LandingObserver>(model_, state_, landing_->lander, landing_->run_spec);
-  if (!state_.forces_valid) prime(model_, state_);
+// A fresh run of the scene from the current state: observers prepared and
+// started, forces primed, the first stage begun.
+void Twin::restart_run() {
+  scene_run_.reset();
+  RunOptions ro;
+  ro.progress_every = 0;
+  run_ = std::make_unique<Run>(model_, state_, scene_->plan, ro);
+  scene_run_ = scene_->begin(*run_, "");
+  for (Observer* o : scene_run_->observers()) run_->add_observer(o);
+  step0_ = state_.step;
+  ended_ = run_->ended();
+  if (ended_) run_->finish();
 }
 
 void Twin::step() {
@@ -61,12 +53,32 @@ void Twin::step() {
       state_.body_applied_torque.clear();
     }
   }
-  rt::step(model_, state_);
-  if (observer_ && !ended_ && observer_->observe()) {
-    ended_ = true;
-    final_ = observer_->finish();
-    final_.steps = state_.step - start_state_.step;
+  if (ended_) {
+    rt::step(model_, state_);
+    return;
   }
+  run_->advance();
+  if (run_->ended()) {
+    ended_ = true;
+    run_->finish();
+  }
+}
+
+RunReport Twin::report() const {
+  RunReport r = run_->report();
+  r.steps = state_.step - step0_;
+  r.sim_time = state_.time;
+  return r;
+}
+
+std::string Twin::result_line() const { return scene_run_->result_line(model_, state_, report()); }
+
+void Twin::write_summary(const std::string& path, const std::string& status, const std::string& message,
+                         int threads) const {
+  RunReport r = report();
+  r.status = status;
+  r.message = message;
+  scene_run_->write_summary(path, model_, state_, r, threads);
 }
 
 int Twin::body_index(const std::string& name) const {
@@ -75,25 +87,7 @@ int Twin::body_index(const std::string& name) const {
   return -1;
 }
 
-LandingOutcome Twin::outcome() const {
-  if (ended_) return final_;
-  return observer_ ? observer_->outcome() : LandingOutcome();
-}
-
-const char* Twin::phase() const {
-  if (!observer_) return "";
-  return ended_ ? "ended" : observer_->tracker().phase();
-}
-
-double Twin::bed_top() const {
-  return observer_ ? observer_->bed_top() : std::numeric_limits<double>::infinity();
-}
-
-double Twin::lowest_corner() const {
-  return observer_ ? observer_->tracker().lowest_corner(state_.bodies[landing_->lander]) : 0.0;
-}
-
-BodyContacts Twin::contacts(int b) const { return body_contacts(state_, b, bed_top()); }
+BodyContacts Twin::contacts(int b) const { return body_contacts(state_, b, scene_->bed_top()); }
 
 void Twin::set_body_state(int b, const Vec3& ref_pos, const Quat& ref_q, const Vec3& vel, const Vec3& omega) {
   const BodyModel& bm = model_.bodies.at(b);
@@ -123,12 +117,13 @@ void Twin::apply_wrench(int b, const Vec3& force, const Vec3& torque, double unt
 void Twin::save(const std::string& path) const { save_checkpoint(path, model_, state_); }
 
 void Twin::load(const std::string& path) {
-  State loaded = load_checkpoint(path, start_model_);
-  observer_.reset();
-  model_ = start_model_;
+  State loaded = load_checkpoint(path, scene_->sc.model);
+  scene_run_.reset();
+  run_.reset();
+  model_ = scene_->sc.model;
   state_ = std::move(loaded);
   wrench_until_.clear();
-  restart_observer();
+  restart_run();
 }
 
 }  // namespace rt

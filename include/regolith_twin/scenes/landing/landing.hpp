@@ -1,6 +1,7 @@
-// Lander scenes (SCENARIOS.md A): placing the lander for an attitude, impact
-// angle and speed; perturbed beds; and the landing outcome with the published
-// definitions (trim plane, run end, ballistic extrapolation, corners).
+// Lander scenes (docs/scenes.md A): placing the lander for an attitude,
+// impact angle and speed; perturbed beds; and the landing outcome with the
+// published definitions (trim plane, run end, ballistic extrapolation,
+// corners), tracked from the lander's state alone.
 #pragma once
 
 #include <memory>
@@ -8,6 +9,8 @@
 #include <vector>
 
 #include "regolith_twin/core/state.hpp"
+#include "regolith_twin/observers/body_contacts.hpp"
+#include "regolith_twin/run/observer.hpp"
 
 namespace YAML {
 class Node;
@@ -84,15 +87,6 @@ void place_lander(const Model& m, State& s, int b, const LandingSpec& spec);
 std::vector<Vec3> lander_corners(const Model& m, const State& s, int b);
 std::vector<Vec3> lander_corners(const BodyModel& bm, const BodyState& bs);
 
-// Contacts of body b in the current state: every grain and body contact
-// point, and those with the bed (a body, or a grain whose centre is at most
-// bed_top high).
-struct BodyContacts {
-  long total = 0;
-  long bed = 0;
-};
-BodyContacts body_contacts(const State& s, int b, double bed_top);
-
 struct LandingOutcome {
   bool contact = false;          // the lander touched the bed
   // Lift-off: all eight corners above the trim plane, no contact left and the
@@ -159,35 +153,32 @@ class LandingTracker {
   LandingOutcome o_;
 };
 
-// The whole landing outcome, step by step: the tracker, ejecta, the active
-// zone (which changes the model: grains frozen and woken) and, at the end,
-// the far-field and zone-edge checks. Used by run_landing and the ROS node.
-class LandingObserver {
+// The tracker as an observer of a run: the lander's state and contacts after
+// every step, its columns of series.csv, the progress text and the run end.
+class LandingTrackerObserver : public Observer {
  public:
-  // Primes the state's forces if needed. m and s must outlive the observer.
-  LandingObserver(Model& m, State& s, int b, const LandingSpec& sp);
-  ~LandingObserver();
-  // After every step; returns true once the run has ended.
-  bool observe();
-  // The outcome so far, and the final one (ratios, far-field checks).
-  LandingOutcome outcome() const;
-  LandingOutcome finish();
-  BodyContacts contacts() const;  // of the lander, with the bed top of this scene
-  double bed_top() const { return sp_.rim + mean_r_; }
-  const LandingTracker& tracker() const { return tracker_; }
+  // bed_top: grains above it are not bed (their touches do not count as bed contacts).
+  LandingTrackerObserver(int lander, const LandingSpec& sp, double bed_top) : b_(lander), sp_(sp), bed_top_(bed_top) {}
+  void start(const Model& m, const State& s) override;
+  bool after_step(Model& m, State& s) override;
+  void columns(std::vector<std::string>& out) const override;
+  void row(const Model& m, const State& s, std::vector<double>& out) const override;
+  // The tracker's end figures and the far-field check (RMS grain speed in the container's outer ring).
+  void finish(Model& m, State& s) override;
+  std::string progress(const Model& m, const State& s) const override;
+  double time_left(const State& s) const override;
+
+  const LandingTracker& tracker() const { return *tracker_; }
+  double max_overlap_ratio() const { return max_overlap_; }
+  double far_field_rms() const { return far_field_rms_; }
 
  private:
-  class ActiveZone;
-  Model& m_;
-  State& s_;
   int b_;
   LandingSpec sp_;
-  LandingTracker tracker_;
-  std::unique_ptr<ActiveZone> zone_;
-  double mean_r_ = 0;
-  int check_every_ = 1;
-  std::vector<uint8_t> ejected_, above0_;
-  LandingOutcome extra_;  // ejecta and overlap figures
+  double bed_top_;
+  std::unique_ptr<LandingTracker> tracker_;
+  double max_overlap_ = 0;
+  double far_field_rms_ = 0;
 };
 
 struct LandingOptions {
@@ -195,12 +186,10 @@ struct LandingOptions {
   double progress_every = 2.0;   // wall seconds between progress lines (<= 0: none)
 };
 
-// Run the landing from the placed state to the run end, observing the outcome.
-// The model is changed only by the active zone (grains frozen and woken).
+// Run the landing from the placed state to the run end (through the run
+// loop, with the landing's observers), writing series.csv and surface.csv
+// into opt.out_dir. The model is changed only by the active zone (grains
+// frozen and woken).
 LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& spec, const LandingOptions& opt);
-
-// Height map of the bed surface (top of the highest grain per cell) over the
-// container, written as CSV rows "x,y,height above the trim plane".
-void write_surface(const std::string& path, const Model& m, const State& s, const LandingSpec& spec, double cell);
 
 }  // namespace rt

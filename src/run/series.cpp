@@ -1,5 +1,5 @@
 // CSV series and JSON summary writers.
-#include "regolith_twin/observe/series.hpp"
+#include "regolith_twin/run/series.hpp"
 
 #include <sys/stat.h>
 

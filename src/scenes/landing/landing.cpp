@@ -1,6 +1,6 @@
 // Lander scenes: placement, perturbed beds and the landing outcome
-// (SCENARIOS.md A). See landing.hpp.
-#include "regolith_twin/observe/landing.hpp"
+// (docs/scenes.md A). See landing.hpp.
+#include "regolith_twin/scenes/landing/landing.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -15,7 +15,8 @@
 
 #include "regolith_twin/core/energy.hpp"
 #include "regolith_twin/core/step.hpp"
-#include "regolith_twin/observe/series.hpp"
+#include "regolith_twin/run/series.hpp"
+#include "regolith_twin/scenes/landing/landing_scene.hpp"
 
 namespace rt {
 namespace {
@@ -240,44 +241,6 @@ std::vector<Vec3> lander_corners(const BodyModel& bm, const BodyState& bs) {
 
 std::vector<Vec3> lander_corners(const Model& m, const State& s, int b) { return lander_corners(m.bodies[b], s.bodies[b]); }
 
-BodyContacts body_contacts(const State& s, int b, double bed_top) {
-  BodyContacts c;
-  const BodyGrainList& bl = s.body_grains;
-  for (int k = 0; k < bl.size(); ++k)
-    if (bl.touching[k] && bl.body[k] == b) {
-      ++c.total;
-      c.bed += s.pos[bl.grain[k]].z() <= bed_top;
-    }
-  for (const BodyPointContact& p : s.body_points)
-    if (p.a == b || p.b == b) {
-      ++c.total;
-      ++c.bed;
-    }
-  return c;
-}
-
-void write_surface(const std::string& path, const Model& m, const State& s, const LandingSpec& sp, double cell) {
-  const int n = int(std::ceil(2 * sp.container_radius / cell));
-  std::vector<double> top(size_t(n) * n, -1e300);
-  for (int i = 0; i < m.n_grains; ++i) {
-    const int ix = int((s.pos[i].x() + sp.container_radius) / cell), iy = int((s.pos[i].y() + sp.container_radius) / cell);
-    if (ix < 0 || iy < 0 || ix >= n || iy >= n) continue;
-    double& t = top[size_t(iy) * n + ix];
-    t = std::max(t, s.pos[i].z() + m.grain_radius[i] - sp.rim);
-  }
-  std::ofstream out(path);
-  if (!out) throw InputError(path + ": cannot write the surface height map");
-  out << "x,y,height\n";
-  for (int iy = 0; iy < n; ++iy)
-    for (int ix = 0; ix < n; ++ix) {
-      const double t = top[size_t(iy) * n + ix];
-      if (t < -1e299) continue;
-      out << (ix + 0.5) * cell - sp.container_radius << ',' << (iy + 0.5) * cell - sp.container_radius << ',' << t
-          << '\n';
-    }
-}
-
-
 LandingTracker::LandingTracker(const BodyModel& bm, const LandingSpec& sp, const Vec3& gravity, double t_start)
     : bm_(bm), sp_(sp), g_(gravity), t_start_(t_start) {
   if (const int k = largest_box(bm); k >= 0)
@@ -383,181 +346,75 @@ void LandingTracker::finish(double t) {
   }
 }
 
-// Active zone: freeze grains (infinite mass, at rest) beyond the radius from
-// the lander's vertical axis, wake those it reaches; woken grains stay free.
-class LandingObserver::ActiveZone {
- public:
-  ActiveZone(Model& m, double radius) : m_(m), radius_(radius) {
-    inv_mass_ = m.grain_inv_mass;
-    inv_inertia_ = m.grain_inv_inertia;
-    fixed0_ = m.grain_fixed;
-    woken_.assign(m.n_grains, 0);
-  }
-  // Update around horizontal position c; returns true when grains changed state.
-  bool update(State& s, const Vec3& c, bool first) {
-    if (radius_ <= 0) return false;
-    if (!first && std::hypot(c.x() - last_.x(), c.y() - last_.y()) < 0.02) return false;
-    last_ = c;
-    bool changed = false;
-    for (int i = 0; i < m_.n_grains; ++i) {
-      if (fixed0_[i] || woken_[i]) continue;
-      const bool inside = std::hypot(s.pos[i].x() - c.x(), s.pos[i].y() - c.y()) < radius_;
-      if (inside) {
-        woken_[i] = 1;
-        m_.grain_fixed[i] = 0;
-        m_.grain_inv_mass[i] = inv_mass_[i];
-        m_.grain_inv_inertia[i] = inv_inertia_[i];
-        changed = changed || !first;
-      } else if (first) {
-        m_.grain_fixed[i] = 1;
-        m_.grain_inv_mass[i] = 0;
-        m_.grain_inv_inertia[i] = 0;
-        s.vel[i].setZero();
-        s.omega[i].setZero();
-        changed = true;
-      }
-    }
-    if (changed) s.rebuild_requested = true;  // pair constants (m*) and partitions follow
-    return changed;
-  }
-  double radius() const { return radius_; }
-  const Vec3& centre() const { return last_; }
+// --- the tracker as an observer ---------------------------------------------------
 
- private:
-  Model& m_;
-  double radius_;
-  std::vector<double> inv_mass_, inv_inertia_;
-  std::vector<uint8_t> fixed0_, woken_;
-  Vec3 last_ = Vec3::Zero();
-};
-
-LandingObserver::LandingObserver(Model& m, State& s, int b, const LandingSpec& sp)
-    : m_(m), s_(s), b_(b), sp_(sp), tracker_(m.bodies[b], sp, m.gravity, s.time) {
-  for (int i = 0; i < m.n_grains; ++i) mean_r_ += m.grain_radius[i];
-  mean_r_ = m.n_grains ? mean_r_ / m.n_grains : 0;
-  ejected_.assign(m.n_grains, 0);
-  above0_.assign(m.n_grains, 0);
-  for (int i = 0; i < m.n_grains; ++i) above0_[i] = s.pos[i].z() > sp.rim + mean_r_;  // not counted
-  zone_ = std::make_unique<ActiveZone>(m, sp.active_radius);
-  zone_->update(s, s.bodies[b].pos, true);
-  if (!s.forces_valid || s.rebuild_requested) prime(m, s);
-  check_every_ = std::max(1, int(std::lround(1e-3 / m.dt)));  // ejecta sampled each millisecond
+void LandingTrackerObserver::start(const Model& m, const State& s) {
+  tracker_ = std::make_unique<LandingTracker>(m.bodies[b_], sp_, m.gravity, s.time);
 }
 
-LandingObserver::~LandingObserver() = default;
-
-BodyContacts LandingObserver::contacts() const { return body_contacts(s_, b_, sp_.rim + mean_r_); }
-
-bool LandingObserver::observe() {
-  const BodyState& bs = s_.bodies[b_];
-  extra_.max_overlap_ratio = std::max(extra_.max_overlap_ratio, s_.stats.max_overlap_ratio);
-  const bool ended = tracker_.update(s_.time, bs, contacts());
-  if (s_.step % check_every_ == 0) {
-    zone_->update(s_, bs.pos, false);
-    for (int i = 0; i < m_.n_grains; ++i)
-      if (!ejected_[i] && !above0_[i] && s_.pos[i].z() > sp_.rim + mean_r_) {
-        ejected_[i] = 1;
-        ++extra_.ejected_grains;
-        extra_.ejected_volume += 4.0 / 3.0 * M_PI * std::pow(m_.grain_radius[i], 3);
-      }
-  }
-  return ended;
+bool LandingTrackerObserver::after_step(Model& m, State& s) {
+  max_overlap_ = std::max(max_overlap_, s.stats.max_overlap_ratio);
+  return tracker_->update(s.time, s.bodies[b_], body_contacts(s, b_, bed_top_));
 }
 
-LandingOutcome LandingObserver::outcome() const {
-  LandingOutcome o = tracker_.outcome();
-  o.ejected_grains = extra_.ejected_grains;
-  o.ejected_volume = extra_.ejected_volume;
-  o.max_overlap_ratio = extra_.max_overlap_ratio;
-  return o;
+void LandingTrackerObserver::columns(std::vector<std::string>& out) const {
+  for (const char* c : {"x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz", "lowest_corner", "grain_contacts",
+                        "body_contacts", "fx", "fy", "fz", "E_lin", "E_rot", "max_overlap_ratio"})
+    out.push_back(c);
 }
 
-LandingOutcome LandingObserver::finish() {
-  tracker_.finish(s_.time);
-  LandingOutcome o = outcome();
-  // Far-field quiet check: RMS grain speed in the outermost ring.
+void LandingTrackerObserver::row(const Model& m, const State& s, std::vector<double>& out) const {
+  const BodyModel& bm = m.bodies[b_];
+  const BodyState& bs = s.bodies[b_];
+  out.insert(out.end(), {bs.pos.x(), bs.pos.y(), bs.pos.z(), bs.vel.x(), bs.vel.y(), bs.vel.z(), bs.omega.x(),
+                         bs.omega.y(), bs.omega.z(), tracker_->lowest_corner(bs), double(s.stats.body_contacts),
+                         double(s.stats.body_body_contacts), bs.force.x(), bs.force.y(), bs.force.z(),
+                         body_lin_energy(bm, bs), body_rot_energy(bm, bs), s.stats.max_overlap_ratio});
+}
+
+void LandingTrackerObserver::finish(Model& m, State& s) {
+  tracker_->finish(s.time);
   double sum = 0;
   long cnt = 0;
-  for (int i = 0; i < m_.n_grains; ++i)
-    if (std::hypot(s_.pos[i].x(), s_.pos[i].y()) > sp_.container_radius - sp_.far_ring) {
-      sum += s_.vel[i].squaredNorm();
+  for (int i = 0; i < m.n_grains; ++i)
+    if (std::hypot(s.pos[i].x(), s.pos[i].y()) > sp_.container_radius - sp_.far_ring) {
+      sum += s.vel[i].squaredNorm();
       ++cnt;
     }
-  o.far_field_rms = cnt ? std::sqrt(sum / cnt) : 0;
-  sum = 0;
-  cnt = 0;
-  for (int i = 0; i < m_.n_grains; ++i) {
-    o.active_grains += m_.grain_inv_mass[i] != 0;
-    const double d = std::hypot(s_.pos[i].x() - zone_->centre().x(), s_.pos[i].y() - zone_->centre().y());
-    if (zone_->radius() > 0 && m_.grain_inv_mass[i] != 0 && !ejected_[i] && d > zone_->radius() - sp_.far_ring) {
-      sum += s_.vel[i].squaredNorm();
-      ++cnt;
-    }
-  }
-  o.active_edge_rms = cnt ? std::sqrt(sum / cnt) : 0;
-  return o;
+  far_field_rms_ = cnt ? std::sqrt(sum / cnt) : 0;
+}
+
+std::string LandingTrackerObserver::progress(const Model& m, const State& s) const {
+  const BodyState& bs = s.bodies[b_];
+  char b[160];
+  std::snprintf(b, sizeof b, "%s  speed %.4g m/s  lowest corner %+.4f m  %d grain contacts", tracker_->phase(),
+                bs.vel.norm(), tracker_->lowest_corner(bs), int(s.stats.body_contacts));
+  return b;
+}
+
+double LandingTrackerObserver::time_left(const State& s) const {
+  const LandingOutcome& o = tracker_->outcome();
+  if (!o.contact) return -1;
+  return (!o.lifted_off ? o.t_contact + sp_.max_after_contact : o.t_liftoff + sp_.after_liftoff) - s.time;
 }
 
 LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& sp, const LandingOptions& opt) {
-  using Clock = std::chrono::steady_clock;
-  const BodyModel& bm = m.bodies[b];
-  const auto t0 = Clock::now();
-  auto last_progress = t0;
-  const double t_start = s.time;
-  const long step0 = s.step;
-  CsvSeries series;
-  const bool write = !opt.out_dir.empty();
-  if (write)
-    series.open(opt.out_dir + "/series.csv",
-                {"t", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz", "lowest_corner", "grain_contacts",
-                 "body_contacts", "fx", "fy", "fz", "E_lin", "E_rot", "max_overlap_ratio", "ejected_grains"});
-  LandingObserver obs(m, s, b, sp);
-  double next_sample = s.time;
-  const BodyState& bs = s.bodies[b];
-  auto sample = [&] {
-    series.row({s.time, bs.pos.x(), bs.pos.y(), bs.pos.z(), bs.vel.x(), bs.vel.y(), bs.vel.z(), bs.omega.x(),
-                bs.omega.y(), bs.omega.z(), obs.tracker().lowest_corner(bs), double(s.stats.body_contacts),
-                double(s.stats.body_body_contacts), bs.force.x(), bs.force.y(), bs.force.z(),
-                body_lin_energy(bm, bs), body_rot_energy(bm, bs), s.stats.max_overlap_ratio,
-                double(obs.outcome().ejected_grains)});
-  };
-  std::string status = "ok", message;
-  try {
-    for (;;) {
-      if (write && s.time >= next_sample - 0.5 * m.dt) {
-        next_sample += sp.sample_every;
-        sample();
-      }
-      step(m, s);
-      if (obs.observe()) break;
-      if (opt.progress_every > 0) {
-        const auto now = Clock::now();
-        if (std::chrono::duration<double>(now - last_progress).count() >= opt.progress_every) {
-          last_progress = now;
-          const LandingOutcome& o = obs.tracker().outcome();
-          const double wall = std::chrono::duration<double>(now - t0).count();
-          double left = !o.contact ? 0 : (!o.lifted_off ? o.t_contact + sp.max_after_contact : o.t_liftoff + sp.after_liftoff) - s.time;
-          const double rate = (s.time - t_start) / std::max(wall, 1e-9);
-          std::fprintf(stderr,
-                       "[landing] %s  t = %.4g s  speed %.4g m/s  lowest corner %+.4f m  %d grain contacts  %.3g steps/s  "
-                       "%s%.0f s\n",
-                       obs.tracker().phase(), s.time, bs.vel.norm(), obs.tracker().lowest_corner(bs),
-                       int(s.stats.body_contacts), double(s.step - step0) / std::max(wall, 1e-9),
-                       !o.contact ? "" : "at most ", left / std::max(rate, 1e-300));
-        }
-      }
-    }
-  } catch (const BlowUpError& e) {
-    status = "blow_up";
-    message = e.what();
-  }
-  LandingOutcome o = obs.finish();
-  o.status = status;
-  o.message = message;
-  o.steps = s.step - step0;
-  o.wall_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  if (write && o.status == "ok") sample();
-  return o;
+  LandingScene scene;
+  scene.sc.name = "landing";
+  scene.lander = b;
+  scene.spec = scene.run_spec = sp;
+  scene.plan = RunPlan::open_ended("landing", "landing");
+  scene.sample_every = sp.sample_every;
+  RunOptions runo;
+  runo.out_dir = opt.out_dir;
+  runo.sample_every = sp.sample_every;
+  runo.progress_every = opt.progress_every;
+  Run run(m, s, scene.plan, runo);
+  std::unique_ptr<SceneRun> sr = scene.begin(run, opt.out_dir);
+  for (Observer* o : sr->observers()) run.add_observer(o);
+  const RunReport rep = run.run();
+  if (!opt.out_dir.empty()) sr->write_files(opt.out_dir, m, s, rep);
+  return static_cast<const LandingRun&>(*sr).outcome(rep, true);
 }
 
 }  // namespace rt

@@ -1,0 +1,38 @@
+// Observers: the measurements of a run, behind one small interface. The run
+// loop (run.hpp) calls start() once before the first step, after_step() after
+// every step, asks each observer for its columns of the time series when a row
+// is due, and finish() at the run end. An observer reads the state; it may
+// change the model only where that is its purpose (the active zone freezes and
+// wakes grains). Scene kinds compose their runs from these (docs/scenes.md).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "regolith_twin/core/state.hpp"
+
+namespace rt {
+
+class Observer {
+ public:
+  virtual ~Observer() = default;
+  // Before the first step, ahead of the forces of the start state: an
+  // observer that changes the model does it here (and clears s.forces_valid
+  // when the forces must be recomputed).
+  virtual void prepare(Model& m, State& s) {}
+  // Before the first step, once the forces of the start state are known.
+  virtual void start(const Model& m, const State& s) {}
+  // After every step; true ends the run (a landing that has lifted off and flown).
+  virtual bool after_step(Model& m, State& s) { return false; }
+  // Names of this observer's columns of series.csv, and their values now.
+  virtual void columns(std::vector<std::string>& out) const {}
+  virtual void row(const Model& m, const State& s, std::vector<double>& out) const {}
+  // At the run end (also after a blow-up).
+  virtual void finish(Model& m, State& s) {}
+  // Text for the progress line ("" for none).
+  virtual std::string progress(const Model& m, const State& s) const { return ""; }
+  // Simulated time left at most, s, when the observer knows it (< 0: it does not).
+  virtual double time_left(const State& s) const { return -1; }
+};
+
+}  // namespace rt

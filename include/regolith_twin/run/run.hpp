@@ -1,0 +1,134 @@
+// The one run loop: stages -> step -> observers -> outputs. Every tool runs
+// through it: regolith_sim and regolith_land, the bed relaxation of a scene,
+// the sweep (through regolith_land) and the ROS node (through rt::Twin, which
+// advances it one step at a time).
+//
+// A run works on a model and a state it does not own, following a plan of
+// stages (a scenario's `stages:`, or one open-ended stage that an observer
+// ends, as a landing's). Per step: the stage's gravity ramp, a series row when
+// one is due, the engine step, the stage's after-step actions (held groups,
+// quick-min, spring release, quench), the observers (any of which may end the
+// run), the stage's end criteria, and a progress line every few wall seconds.
+// A numerical blow-up ends run() with status "blow_up" and keeps what was
+// written. See docs/architecture.md.
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "regolith_twin/run/observer.hpp"
+#include "regolith_twin/run/series.hpp"
+#include "regolith_twin/scene/scenario.hpp"
+
+namespace rt {
+
+// The stages of a run and what they refer to (groups, the scene stiffness).
+struct RunPlan {
+  std::string name;                   // progress-line label
+  std::vector<Stage> stages;
+  std::vector<GrainGroup> groups;     // kept current when a stage trims grains
+  double scene_kn = 0, scene_dt = 0, scene_body_kn = 0;  // what stiffness_scale scales
+  // A scenario's stages.
+  static RunPlan of(const Scenario& sc);
+  // One stage without a time limit: an observer ends the run.
+  static RunPlan open_ended(const std::string& name, const std::string& stage = "run");
+};
+
+struct RunOptions {
+  std::string out_dir;          // series.csv (and stage snapshots) written here; empty: nothing written
+  double sample_every = 0.01;   // s of simulated time between series rows
+  double progress_every = 2.0;  // wall seconds between progress lines (<= 0: none)
+  bool stage_snapshots = false; // write out_dir/<stage>.bed (compact snapshot) after every stage
+};
+
+struct StageReport {
+  std::string name;
+  double t_end = 0;         // simulated time at the end of the stage, s
+  std::string reason;       // "duration", "criteria" or "observer"
+  int grains_removed = 0;   // by the stage's trim
+};
+
+struct RunReport {
+  std::string status = "ok";  // ok | blow_up
+  std::string message;        // diagnostic when not ok
+  long steps = 0;             // taken by this run
+  double sim_time = 0;        // s at the end
+  double wall_seconds = 0;
+  double max_overlap_ratio = 0;
+  bool ended_by_observer = false;
+  std::vector<StageReport> stages;
+};
+
+class Run {
+ public:
+  // m and s must outlive the run; observers are added before the first step.
+  Run(Model& m, State& s, RunPlan plan, const RunOptions& opt = {});
+  ~Run();
+  Run(const Run&) = delete;
+  Run& operator=(const Run&) = delete;
+
+  // Observers are not owned; their order is the order of their series columns.
+  void add_observer(Observer* o);
+
+  // One step, with the stage transitions before it and the observers after
+  // it. Returns false (and steps nothing) once the run has ended. Throws BlowUpError.
+  bool advance();
+  // Stage transitions only: true once every stage is done or an observer ended the run.
+  bool ended();
+
+  // To the end: advance() until the run ends, a blow-up caught into the
+  // report; then the observers' finish() and the final series row.
+  RunReport run();
+  // The observers' finish() (run() calls it; a stepping front end calls it at the end).
+  void finish();
+
+  const RunReport& report() const { return rep_; }
+  Model& model() { return m_; }
+  State& state() { return s_; }
+  const Model& model() const { return m_; }
+  const State& state() const { return s_; }
+  const std::vector<GrainGroup>& groups() const { return plan_.groups; }
+  const RunPlan& plan() const { return plan_; }
+  int stage_index() const { return int(k_); }
+  // Grains held in place by the current stage (one flag per grain).
+  const std::vector<uint8_t>& held() const { return held_; }
+
+ private:
+  bool settle();  // stage transitions up to the next step; false at the end
+  void begin_stage();
+  void end_stage(const char* reason);
+  void sample();
+  void progress();
+
+  Model& m_;
+  State& s_;
+  RunPlan plan_;
+  RunOptions opt_;
+  std::vector<Observer*> obs_;
+  RunReport rep_;
+  CsvSeries series_;
+  bool started_ = false, in_stage_ = false, ended_ = false, finished_ = false;
+  size_t k_ = 0;                      // current stage
+  double t_stage_end_ = 0, next_sample_ = 0, next_check_ = 0, next_quench_ = 0;
+  double t_start_ = 0, t_ramp0_ = 0;
+  long step0_ = 0;
+  Vec3 g_from_ = Vec3::Zero();
+  std::vector<uint8_t> held_;
+  std::vector<int> held_ids_;
+  std::vector<Vec3> held_pos_;
+  StageReport sr_;
+  std::chrono::steady_clock::time_point t0_, last_progress_;
+};
+
+// RMS and largest speed of the free grains not flagged in `skip`.
+struct GrainSpeeds {
+  double rms = 0, max = 0;
+};
+GrainSpeeds grain_speeds(const Model& m, const State& s, const std::vector<uint8_t>& skip);
+
+// "m:ss" or "h:mm:ss".
+std::string clock_text(double seconds);
+
+}  // namespace rt

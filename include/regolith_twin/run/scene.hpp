@@ -1,0 +1,108 @@
+// Scene kinds and their registry. A scene file is a scenario (materials,
+// walls, bodies, grains, stages) plus at most one block naming its kind
+// (`landing:` ...); a file without one is a plain scenario whose stages are
+// the run. A kind reads and validates its own block (errors name file, key and
+// range), prepares its scene on the scenario (bed relaxed and cached,
+// bodies placed), and for each run contributes its observers and writes its
+// outputs. The ROS node adds a kind's topics through the ROS registry
+// (ros/scene_topics.hpp). Adding a kind: docs/architecture.md.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "regolith_twin/run/run.hpp"
+
+namespace YAML {
+class Node;
+}
+
+namespace rt {
+
+struct SceneOptions {
+  std::string cache_dir;   // relaxed beds (empty: default_cache_dir())
+  std::string relax_out;   // output folder of a bed relaxation (empty: none written)
+  bool quiet = false;      // no progress lines while preparing
+};
+
+// One run of a prepared scene: its observers, and its outputs written from them.
+class SceneRun {
+ public:
+  virtual ~SceneRun() = default;
+  // In the order of their series columns.
+  virtual std::vector<Observer*> observers() = 0;
+  // summary.json of the run (status and message from the report).
+  virtual void write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
+                             int threads) const = 0;
+  // The kind's other files (summary.json and series.csv aside), written at the end of run_scene.
+  virtual void write_files(const std::string& dir, const Model& m, const State& s, const RunReport& rep) const {}
+  // Names of the files a run writes, for the "results are in" lines: {label, file name}.
+  virtual std::vector<std::pair<std::string, std::string>> files() const {
+    return {{"summary", "summary.json"}, {"time series", "series.csv"}};
+  }
+  // One line on the outcome, for the command line and the node's log.
+  virtual std::string result_line(const Model& m, const State& s, const RunReport& rep) const = 0;
+};
+
+// A scene made ready to run: the scenario as the run starts it, its start
+// state and plan; begin() makes the observers of one run.
+class Scene {
+ public:
+  virtual ~Scene() = default;
+  virtual std::string kind() const = 0;
+  Scenario sc;               // model, groups and settings at the start of the run
+  State start;               // start state of the run
+  RunPlan plan;              // stages of the run
+  double sample_every = 0.01;  // s between series rows
+  // Grains above this height are not bed: contacts with them do not count as
+  // bed contacts (a lander's touches by ejecta), m.
+  virtual double bed_top() const;
+  // Observers and outputs of one run (whose model and state start as
+  // sc.model and start); the caller adds the observers to the run. A front
+  // end that writes no files per run passes an empty out_dir.
+  virtual std::unique_ptr<SceneRun> begin(Run& run, const std::string& out_dir) const = 0;
+};
+
+class SceneKind {
+ public:
+  virtual ~SceneKind() = default;
+  // Name of the kind, and the top-level YAML block that selects it.
+  virtual std::string name() const = 0;
+  // Prepare the scene from the document (overrides applied), read from `file`.
+  // Throws InputError for bad input, BlowUpError if a preparation run fails.
+  virtual std::unique_ptr<Scene> prepare(const YAML::Node& root, const std::string& file,
+                                         const SceneOptions& opt) const = 0;
+};
+
+// The registry: the built-in kinds (src/scenes/registry.cpp) and any added at
+// run time (tests add their own).
+void register_scene_kind(std::shared_ptr<const SceneKind> kind);
+std::vector<std::string> scene_kind_names();
+
+// The kind a document asks for: the registered kind whose block it has, the
+// plain scenario if none. Two kind blocks are refused, naming both.
+const SceneKind& scene_kind_of(const YAML::Node& root, const std::string& file);
+
+// Read a scene file with overrides ("dotted.key=yaml-value") and prepare it.
+std::unique_ptr<Scene> load_scene(const std::string& file, const std::vector<std::string>& overrides,
+                                  const SceneOptions& opt = {});
+
+struct SceneRunOptions {
+  std::string out_dir;          // empty: nothing written
+  double progress_every = 2.0;  // wall seconds between progress lines (<= 0: none)
+  bool stage_snapshots = false; // out_dir/<stage>.bed after every stage
+  int threads = 0;              // recorded in the summary
+};
+
+// Run a prepared scene from state s (initially scene.start) to its end on
+// model m (initially scene.sc.model), writing series.csv, summary.json and
+// the kind's files into out_dir. `run` (if given) receives the scene run, for
+// callers that read its observers afterwards.
+RunReport run_scene(const Scene& scene, Model& m, State& s, const SceneRunOptions& opt,
+                    std::unique_ptr<SceneRun>* run = nullptr);
+
+// $REGOLITH_CACHE, else ~/.cache/regolith_twin.
+std::string default_cache_dir();
+
+}  // namespace rt

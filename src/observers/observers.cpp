@@ -1,0 +1,160 @@
+// Reusable observers: body contacts, ejecta, active zone, surface height map,
+// region count (see their headers in observers/).
+#include <cmath>
+#include <fstream>
+
+#include "regolith_twin/core/step.hpp"
+#include "regolith_twin/observers/active_zone.hpp"
+#include "regolith_twin/observers/body_contacts.hpp"
+#include "regolith_twin/observers/ejecta.hpp"
+#include "regolith_twin/observers/region_count.hpp"
+#include "regolith_twin/observers/surface_map.hpp"
+
+namespace rt {
+
+BodyContacts body_contacts(const State& s, int b, double bed_top) {
+  BodyContacts c;
+  const BodyGrainList& bl = s.body_grains;
+  for (int k = 0; k < bl.size(); ++k)
+    if (bl.touching[k] && bl.body[k] == b) {
+      ++c.total;
+      c.bed += s.pos[bl.grain[k]].z() <= bed_top;
+    }
+  for (const BodyPointContact& p : s.body_points)
+    if (p.a == b || p.b == b) {
+      ++c.total;
+      ++c.bed;
+    }
+  return c;
+}
+
+// --- ejecta ---------------------------------------------------------------------
+
+void Ejecta::prepare(Model& m, State& s) {
+  flag_.assign(m.n_grains, 0);
+  above0_.assign(m.n_grains, 0);
+  for (int i = 0; i < m.n_grains; ++i) above0_[i] = s.pos[i].z() > height_;  // not counted
+  count_ = 0;
+  volume_ = 0;
+}
+
+bool Ejecta::after_step(Model& m, State& s) {
+  if (s.step % every_ != 0) return false;
+  for (int i = 0; i < m.n_grains; ++i)
+    if (!flag_[i] && !above0_[i] && s.pos[i].z() > height_) {
+      flag_[i] = 1;
+      ++count_;
+      volume_ += 4.0 / 3.0 * M_PI * std::pow(m.grain_radius[i], 3);
+    }
+  return false;
+}
+
+// --- active zone ----------------------------------------------------------------
+
+void ActiveZone::prepare(Model& m, State& s) {
+  inv_mass_ = m.grain_inv_mass;
+  inv_inertia_ = m.grain_inv_inertia;
+  fixed0_ = m.grain_fixed;
+  woken_.assign(m.n_grains, 0);
+  update(m, s, s.bodies[body_].pos, true);
+  // Lists and forces for the frozen model (and any rebuild already pending).
+  if (s.rebuild_requested) s.forces_valid = false;
+}
+
+bool ActiveZone::after_step(Model& m, State& s) {
+  if (s.step % every_ == 0) update(m, s, s.bodies[body_].pos, false);
+  return false;
+}
+
+// Update around horizontal position c; returns true when grains changed state.
+bool ActiveZone::update(Model& m, State& s, const Vec3& c, bool first) {
+  if (radius_ <= 0) return false;
+  if (!first && std::hypot(c.x() - last_.x(), c.y() - last_.y()) < 0.02) return false;
+  last_ = c;
+  bool changed = false;
+  for (int i = 0; i < m.n_grains; ++i) {
+    if (fixed0_[i] || woken_[i]) continue;
+    const bool inside = std::hypot(s.pos[i].x() - c.x(), s.pos[i].y() - c.y()) < radius_;
+    if (inside) {
+      woken_[i] = 1;
+      m.grain_fixed[i] = 0;
+      m.grain_inv_mass[i] = inv_mass_[i];
+      m.grain_inv_inertia[i] = inv_inertia_[i];
+      changed = changed || !first;
+    } else if (first) {
+      m.grain_fixed[i] = 1;
+      m.grain_inv_mass[i] = 0;
+      m.grain_inv_inertia[i] = 0;
+      s.vel[i].setZero();
+      s.omega[i].setZero();
+      changed = true;
+    }
+  }
+  if (changed) s.rebuild_requested = true;  // pair constants (m*) and partitions follow
+  return changed;
+}
+
+void ActiveZone::finish(Model& m, State& s) {
+  double sum = 0;
+  long cnt = 0;
+  active_ = 0;
+  for (int i = 0; i < m.n_grains; ++i) {
+    active_ += m.grain_inv_mass[i] != 0;
+    const double d = std::hypot(s.pos[i].x() - last_.x(), s.pos[i].y() - last_.y());
+    const bool ejected = ejecta_ && ejecta_->ejected(i);
+    if (radius_ > 0 && m.grain_inv_mass[i] != 0 && !ejected && d > radius_ - ring_) {
+      sum += s.vel[i].squaredNorm();
+      ++cnt;
+    }
+  }
+  edge_rms_ = cnt ? std::sqrt(sum / cnt) : 0;
+}
+
+// --- surface height map ---------------------------------------------------------
+
+void write_surface(const std::string& path, const Model& m, const State& s, double half, double reference,
+                   double cell) {
+  const int n = int(std::ceil(2 * half / cell));
+  std::vector<double> top(size_t(n) * n, -1e300);
+  for (int i = 0; i < m.n_grains; ++i) {
+    const int ix = int((s.pos[i].x() + half) / cell), iy = int((s.pos[i].y() + half) / cell);
+    if (ix < 0 || iy < 0 || ix >= n || iy >= n) continue;
+    double& t = top[size_t(iy) * n + ix];
+    t = std::max(t, s.pos[i].z() + m.grain_radius[i] - reference);
+  }
+  std::ofstream out(path);
+  if (!out) throw InputError(path + ": cannot write the surface height map");
+  out << "x,y,height\n";
+  for (int iy = 0; iy < n; ++iy)
+    for (int ix = 0; ix < n; ++ix) {
+      const double t = top[size_t(iy) * n + ix];
+      if (t < -1e299) continue;
+      out << (ix + 0.5) * cell - half << ',' << (iy + 0.5) * cell - half << ',' << t << '\n';
+    }
+}
+
+// --- region count ---------------------------------------------------------------
+
+void RegionCount::count(const Model& m, const State& s) {
+  n_ = 0;
+  mass_ = 0;
+  for (int i = 0; i < m.n_grains; ++i) {
+    const Vec3& p = s.pos[i];
+    if ((p.array() >= lo_.array()).all() && (p.array() <= hi_.array()).all()) {
+      ++n_;
+      mass_ += m.grain_mass[i];
+    }
+  }
+}
+
+void RegionCount::columns(std::vector<std::string>& out) const {
+  out.push_back(name_ + "_count");
+  out.push_back(name_ + "_mass");
+}
+
+void RegionCount::row(const Model& m, const State& s, std::vector<double>& out) const {
+  out.push_back(double(n_));
+  out.push_back(mass_);
+}
+
+}  // namespace rt

@@ -1,0 +1,74 @@
+// Relax-once-and-cache beds (see bed_cache.hpp).
+#include "regolith_twin/run/bed_cache.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+
+#include "regolith_twin/core/hash.hpp"
+#include "regolith_twin/scene/checkpoint.hpp"
+#include "regolith_twin/scenes/scenario/scenario_scene.hpp"
+
+namespace rt {
+
+std::string bed_key(const Model& m, const State& s, const std::vector<int>& placed) {
+  uint64_t h = kFnvOffset;
+  h = fnv1a(m.grain_radius.data(), m.grain_radius.size() * sizeof(double), h);
+  h = fnv1a(s.pos.data(), s.pos.size() * sizeof(Vec3), h);
+  for (const auto& mat : m.materials) {
+    const double v[] = {mat.density, mat.eps_n, mat.eps_t, mat.mu_s, mat.mu_r, mat.mu_t, mat.beta, mat.young};
+    h = fnv1a(v, sizeof v, h);
+  }
+  for (const auto& w : m.walls) {
+    const double v[] = {w.origin.x(), w.origin.y(), w.origin.z(), w.axis.x(), w.axis.y(), w.axis.z(), w.radius, w.length};
+    h = fnv1a(v, sizeof v, h);
+  }
+  for (size_t k = 0; k < m.bodies.size(); ++k) {
+    if (std::find(placed.begin(), placed.end(), int(k)) != placed.end()) continue;
+    const BodyModel& bm = m.bodies[k];
+    const BodyState& bs = s.bodies[k];
+    const double v[] = {bm.mass, bm.inertia.x(), bm.inertia.y(), bm.inertia.z(), double(bm.fixed), double(bm.material),
+                        bs.pos.x(), bs.pos.y(), bs.pos.z(), bs.q.w(), bs.q.x(), bs.q.y(), bs.q.z()};
+    h = fnv1a(v, sizeof v, h);
+    for (const Shape& sh : bm.shapes) {
+      const double w[] = {double(sh.type), sh.size.x(), sh.size.y(), sh.size.z(), sh.pos.x(), sh.pos.y(), sh.pos.z()};
+      h = fnv1a(w, sizeof w, h);
+    }
+  }
+  const double v[] = {m.gravity.x(), m.gravity.y(), m.gravity.z(), m.kn, m.dt, m.skin, double(m.partitions)};
+  h = fnv1a(v, sizeof v, h);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+RelaxedBed relax_bed(Scenario& sc, const State& s0, const std::vector<int>& placed, const SceneOptions& opt,
+                     const std::string& label) {
+  RelaxedBed out;
+  const Model& m = sc.model;
+  const std::string cache = opt.cache_dir.empty() ? default_cache_dir() : opt.cache_dir;
+  make_dirs(cache + "/beds");
+  out.cache = cache + "/beds/" + bed_key(m, s0, placed) + ".ckpt";
+  if (std::ifstream(out.cache).good()) {
+    out.state = load_checkpoint(out.cache, m);
+    out.from_cache = true;
+    if (!opt.quiet) std::fprintf(stderr, "[%s] relaxed bed from the cache: %s\n", label.c_str(), out.cache.c_str());
+    return out;
+  }
+  if (sc.stages.empty()) throw InputError(sc.file + ": key 'stages': the bed relaxation stage is missing");
+  if (!opt.quiet)
+    std::fprintf(stderr, "[%s] relaxing the bed once (cached afterwards in %s)\n", label.c_str(), out.cache.c_str());
+  out.state = s0;
+  RunOptions ro;
+  ro.out_dir = opt.relax_out;
+  ro.progress_every = opt.quiet ? 0 : 5.0;
+  const RunReport rr = run_scenario(sc, out.state, ro);
+  if (rr.status != "ok") throw BlowUpError("bed relaxation: " + rr.message);
+  if (!opt.quiet)
+    std::fprintf(stderr, "[%s] bed relaxed in %.4g s simulated (%s)\n", label.c_str(), rr.sim_time,
+                 rr.stages.empty() ? "" : rr.stages.back().reason.c_str());
+  save_checkpoint(out.cache, sc.model, out.state);
+  return out;
+}
+
+}  // namespace rt

@@ -1,0 +1,159 @@
+// The command-line tools' shared main (see cli.hpp).
+#include "regolith_twin/run/cli.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "regolith_twin/run/scene.hpp"
+#include "regolith_twin/scene/checkpoint.hpp"
+#include "regolith_twin/scene/snapshot.hpp"
+
+namespace rt {
+namespace {
+
+void usage(std::FILE* f, const char* tool) {
+  std::fprintf(f,
+               "usage: %s SCENE.yaml [--out DIR] [--threads N] [--set key=value]... [--cache DIR] [--quiet]\n"
+               "  --out DIR       results (summary.json, series.csv and the scene's own files; default out/<name>)\n"
+               "  --threads N     OpenMP threads (default: all cores)\n"
+               "  --set k=v       override a key, e.g. --set contact.steps_per_contact=60 or --set landing.angle_deg=60\n"
+               "  --cache DIR     where relaxed beds are kept (default $REGOLITH_CACHE or ~/.cache/regolith_twin)\n"
+               "  --snapshot F    also write the final grains as a compact bed snapshot F (float32)\n"
+               "  --checkpoint F  also write the exact final state (with contact history) to F\n"
+               "  --stage-snapshots  also write DIR/<stage>.bed after every stage (restart points)\n"
+               "  --quiet         no progress lines\n"
+               "scene kinds: a plain scenario, or a file with one of these blocks:",
+               tool);
+  for (const std::string& k : scene_kind_names()) std::fprintf(f, " %s:", k.c_str());
+  std::fprintf(f, "\n");
+}
+
+struct Args {
+  std::string file, out, cache, snapshot, checkpoint;
+  std::vector<std::string> overrides;
+  int threads = 0;
+  bool quiet = false, stage_snapshots = false;
+};
+
+// Returns -1 when the arguments are good, else the exit code.
+int parse(int argc, char** argv, const char* tool, Args& a) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string o = argv[i];
+    auto value = [&](std::string& into) {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s: %s needs a value\n", tool, o.c_str());
+        return false;
+      }
+      into = argv[++i];
+      return true;
+    };
+    std::string v;
+    if (o == "--out" || o == "--cache" || o == "--snapshot" || o == "--checkpoint" || o == "--set" ||
+        o == "--threads") {
+      if (!value(v)) return 2;
+      if (o == "--out") a.out = v;
+      else if (o == "--cache") a.cache = v;
+      else if (o == "--snapshot") a.snapshot = v;
+      else if (o == "--checkpoint") a.checkpoint = v;
+      else if (o == "--set") a.overrides.push_back(v);
+      else {
+        char* end = nullptr;
+        a.threads = int(std::strtol(v.c_str(), &end, 10));
+        if (*end || a.threads < 1 || a.threads > 256) {
+          std::fprintf(stderr, "%s: --threads '%s': expected an integer in [1, 256]\n", tool, v.c_str());
+          return 2;
+        }
+      }
+    } else if (o == "--quiet") {
+      a.quiet = true;
+    } else if (o == "--stage-snapshots") {
+      a.stage_snapshots = true;
+    } else if (o == "-h" || o == "--help") {
+      usage(stdout, tool);
+      return 0;
+    } else if (!o.empty() && o[0] == '-') {
+      std::fprintf(stderr, "%s: unknown option '%s'\n", tool, o.c_str());
+      usage(stderr, tool);
+      return 2;
+    } else if (a.file.empty()) {
+      a.file = o;
+    } else {
+      std::fprintf(stderr, "%s: only one scene file may be given\n", tool);
+      return 2;
+    }
+  }
+  if (a.file.empty()) {
+    usage(stderr, tool);
+    return 2;
+  }
+  return -1;
+}
+
+}  // namespace
+
+int run_cli(int argc, char** argv, const char* tool) {
+  Args a;
+  if (const int rc = parse(argc, argv, tool, a); rc >= 0) return rc;
+#ifdef _OPENMP
+  if (a.threads > 0) omp_set_num_threads(a.threads);
+  const int threads = omp_get_max_threads();
+#else
+  const int threads = 1;
+#endif
+  try {
+    if (a.out.empty()) a.out = "out/" + load_document(a.file, a.overrides)["name"].as<std::string>("scenario");
+    make_dirs(a.out);
+    SceneOptions so;
+    so.cache_dir = a.cache;
+    so.quiet = a.quiet;
+    so.relax_out = a.out + "/bed_relax";
+    std::unique_ptr<Scene> scene = load_scene(a.file, a.overrides, so);
+    Model m = scene->sc.model;
+    State s = scene->start;
+    SceneRunOptions ro;
+    ro.out_dir = a.out;
+    ro.progress_every = a.quiet ? 0 : 2.0;
+    ro.stage_snapshots = a.stage_snapshots;
+    ro.threads = threads;
+    std::unique_ptr<SceneRun> run;
+    const RunReport rep = run_scene(*scene, m, s, ro, &run);
+    if (rep.status != "ok") {
+      std::fprintf(stderr, "%s: %s\n%s: outputs written so far are in %s/\n", tool, rep.message.c_str(), tool,
+                   a.out.c_str());
+      return 3;
+    }
+    if (!a.snapshot.empty()) {
+      write_snapshot(a.snapshot, m, s);
+      std::printf("snapshot:    %s (%d grains)\n", a.snapshot.c_str(), m.n_grains);
+    }
+    if (!a.checkpoint.empty()) {
+      save_checkpoint(a.checkpoint, m, s);
+      std::printf("checkpoint:  %s\n", a.checkpoint.c_str());
+    }
+    std::printf("%s\n", run->result_line(m, s, rep).c_str());
+    for (const auto& [label, name] : run->files()) {
+      const std::string l = label + ":";
+      std::printf("%-12s %s/%s\n", l.c_str(), a.out.c_str(), name.c_str());
+    }
+    return 0;
+  } catch (const BlowUpError& e) {
+    std::fprintf(stderr, "%s: %s\n", tool, e.what());
+    return 3;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "%s: error: %s\n", tool, e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error: %s\n", tool, e.what());
+    return 1;
+  }
+}
+
+}  // namespace rt

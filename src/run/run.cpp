@@ -1,0 +1,299 @@
+// The one run loop (see run.hpp).
+#include "regolith_twin/run/run.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "regolith_twin/core/step.hpp"
+#include "regolith_twin/scene/snapshot.hpp"
+
+namespace rt {
+
+using Clock = std::chrono::steady_clock;
+
+GrainSpeeds grain_speeds(const Model& m, const State& s, const std::vector<uint8_t>& skip) {
+  double sum = 0, mx = 0;
+  long n = 0;
+  for (int i = 0; i < m.n_grains; ++i) {
+    if (m.grain_inv_mass[i] == 0 || skip[i]) continue;
+    const double v2 = s.vel[i].squaredNorm();
+    sum += v2;
+    mx = std::max(mx, v2);
+    ++n;
+  }
+  return {n ? std::sqrt(sum / n) : 0.0, std::sqrt(mx)};
+}
+
+std::string clock_text(double seconds) {
+  char b[32];
+  const long s = long(seconds + 0.5);
+  if (s >= 3600)
+    std::snprintf(b, sizeof b, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
+  else
+    std::snprintf(b, sizeof b, "%ld:%02ld", s / 60, s % 60);
+  return b;
+}
+
+RunPlan RunPlan::of(const Scenario& sc) {
+  RunPlan p;
+  p.name = sc.name;
+  p.stages = sc.stages;
+  p.groups = sc.groups;
+  p.scene_kn = sc.scene_kn;
+  p.scene_dt = sc.scene_dt;
+  p.scene_body_kn = sc.scene_body_kn;
+  return p;
+}
+
+RunPlan RunPlan::open_ended(const std::string& name, const std::string& stage) {
+  RunPlan p;
+  p.name = name;
+  Stage st;
+  st.name = stage;
+  st.duration = std::numeric_limits<double>::infinity();
+  p.stages.push_back(st);
+  return p;
+}
+
+Run::Run(Model& m, State& s, RunPlan plan, const RunOptions& opt)
+    : m_(m), s_(s), plan_(std::move(plan)), opt_(opt) {}
+
+Run::~Run() = default;
+
+void Run::add_observer(Observer* o) { obs_.push_back(o); }
+
+bool Run::ended() { return !settle(); }
+
+// The first call: observers prepared, forces primed, observers started, the
+// series opened. Then stage transitions up to the next step.
+
+bool Run::settle() {
+  if (ended_) return false;
+  if (!started_) {
+    started_ = true;
+    t0_ = last_progress_ = Clock::now();
+    t_start_ = s_.time;
+    step0_ = s_.step;
+    next_sample_ = s_.time;
+    for (Observer* o : obs_) o->prepare(m_, s_);
+    if (!s_.forces_valid) prime(m_, s_);
+    for (Observer* o : obs_) o->start(m_, s_);
+    if (!opt_.out_dir.empty()) {
+      make_dirs(opt_.out_dir);
+      std::vector<std::string> cols = {"t"};
+      for (const Observer* o : obs_) o->columns(cols);
+      series_.open(opt_.out_dir + "/series.csv", cols);
+    }
+  }
+  for (;;) {
+    if (in_stage_) {
+      if (s_.time < t_stage_end_ - 0.5 * m_.dt) return true;
+      end_stage("duration");
+    }
+    if (k_ >= plan_.stages.size()) {
+      ended_ = true;
+      return false;
+    }
+    begin_stage();
+  }
+}
+
+// Stage start: trim, stiffness, gravity, walls taken away, groups held.
+void Run::begin_stage() {
+  const Stage& st = plan_.stages[k_];
+  int removed = 0;
+  if (st.trim) {  // every grain above the trim height goes
+    std::vector<uint8_t> drop(m_.n_grains, 0);
+    for (int i = 0; i < m_.n_grains; ++i) drop[i] = s_.pos[i].z() > st.trim_above;
+    removed = remove_grains(m_, s_, drop, plan_.groups);
+  }
+  if (st.stiffness_scale > 0 && plan_.scene_kn > 0) {
+    // Same steps per contact at the new stiffness. Live springs keep their
+    // extension; the law table is rebuilt for the new k_n.
+    m_.kn = plan_.scene_kn * st.stiffness_scale;
+    if (plan_.scene_body_kn > 0) m_.body_kn = plan_.scene_body_kn * st.stiffness_scale;
+    m_.dt = plan_.scene_dt / std::sqrt(st.stiffness_scale);
+    finalize_model(m_);
+    s_.forces_valid = false;
+  }
+  g_from_ = m_.gravity;
+  if (st.set_gravity && st.gravity_ramp <= 0) m_.gravity = st.gravity;
+  t_ramp0_ = s_.time;
+  held_.assign(m_.n_grains, 0);
+  held_ids_.clear();
+  held_pos_.clear();
+  for (const auto& name : st.remove_walls)
+    for (size_t w = 0; w < m_.walls.size(); ++w)
+      if (m_.walls[w].name == name) {
+        s_.wall_on[w] = 0;
+        s_.rebuild_requested = true;
+      }
+  for (const auto& name : st.hold)
+    for (const GrainGroup& g : plan_.groups)
+      if (g.name == name)
+        for (int i = g.first; i < g.first + g.count; ++i) {
+          held_[i] = 1;
+          held_ids_.push_back(i);
+          held_pos_.push_back(s_.pos[i]);
+        }
+  t_stage_end_ = s_.time + st.duration;
+  next_check_ = s_.time + st.check_every;
+  next_quench_ = s_.time + st.quench_every;
+  sr_ = StageReport{st.name, 0, "duration", removed};
+  in_stage_ = true;
+}
+
+void Run::end_stage(const char* reason) {
+  sr_.reason = reason;
+  sr_.t_end = s_.time;
+  rep_.stages.push_back(sr_);
+  if (!opt_.out_dir.empty() && opt_.stage_snapshots)
+    write_snapshot(opt_.out_dir + "/" + plan_.stages[k_].name + ".bed", m_, s_);
+  in_stage_ = false;
+  ++k_;
+}
+
+bool Run::advance() {
+  if (!settle()) return false;
+  const Stage& st = plan_.stages[k_];
+  if (st.set_gravity && st.gravity_ramp > 0) {
+    // Geometric in magnitude, linear in direction, over gravity_ramp seconds.
+    const double f = std::min(1.0, (s_.time - t_ramp0_) / st.gravity_ramp);
+    const double a = g_from_.norm(), b = st.gravity.norm();
+    if (f >= 1.0 || a == 0 || b == 0) {
+      m_.gravity = f >= 1.0 ? st.gravity : Vec3(g_from_ + f * (st.gravity - g_from_));
+    } else {
+      const Vec3 dir = ((1 - f) * g_from_ / a + f * st.gravity / b).normalized();
+      m_.gravity = dir * (a * std::pow(b / a, f));
+    }
+  }
+  if (s_.time >= next_sample_ - 0.5 * m_.dt) {  // series row before the step
+    if (!opt_.out_dir.empty()) sample();
+    next_sample_ += opt_.sample_every;
+  }
+  step(m_, s_);
+  if (st.minimize) {  // quick-min: keep only the velocity along the net force
+    const int n = m_.n_grains;
+    const Vec3 g = m_.gravity;
+#pragma omp parallel for schedule(static) if (n >= m_.parallel_min_grains)
+    for (int i = 0; i < n; ++i) {
+      if (m_.grain_inv_mass[i] == 0) continue;
+      const Vec3 f = s_.force[i] + g / m_.grain_inv_mass[i];
+      const double p = s_.vel[i].dot(f), f2 = f.squaredNorm();
+      s_.vel[i] = p > 0 && f2 > 0 ? Vec3(f * (p / f2)) : Vec3::Zero();
+      const double pw = s_.omega[i].dot(s_.torque[i]), t2 = s_.torque[i].squaredNorm();
+      s_.omega[i] = pw > 0 && t2 > 0 ? Vec3(s_.torque[i] * (pw / t2)) : Vec3::Zero();
+    }
+  }
+  if (st.release_springs) {
+    for (auto* l : {&s_.pairs.spring_t, &s_.pairs.spring_r, &s_.wall_pairs.spring_t, &s_.wall_pairs.spring_r})
+      std::fill(l->begin(), l->end(), Vec3::Zero());
+    std::fill(s_.pairs.spring_w.begin(), s_.pairs.spring_w.end(), 0.0);
+    std::fill(s_.wall_pairs.spring_w.begin(), s_.wall_pairs.spring_w.end(), 0.0);
+  }
+  if (st.quench_every > 0 && s_.time >= next_quench_ - 0.5 * m_.dt) {
+    next_quench_ += st.quench_every;
+    for (int i = 0; i < m_.n_grains; ++i) {
+      s_.vel[i].setZero();
+      s_.omega[i].setZero();
+    }
+  }
+  rep_.max_overlap_ratio = std::max(rep_.max_overlap_ratio, s_.stats.max_overlap_ratio);
+  for (size_t h = 0; h < held_ids_.size(); ++h) {  // held grains stay put
+    s_.pos[held_ids_[h]] = held_pos_[h];
+    s_.vel[held_ids_[h]].setZero();
+    s_.omega[held_ids_[h]].setZero();
+  }
+  bool end = false;
+  for (Observer* o : obs_) end = o->after_step(m_, s_) || end;
+  if (end) {
+    rep_.ended_by_observer = true;
+    end_stage("observer");
+    ended_ = true;
+    return true;
+  }
+  if ((st.until_rms_speed >= 0 || st.until_max_speed >= 0) && s_.time >= next_check_) {
+    next_check_ += st.check_every;
+    const GrainSpeeds sp = grain_speeds(m_, s_, held_);
+    if ((st.until_rms_speed < 0 || sp.rms < st.until_rms_speed) &&
+        (st.until_max_speed < 0 || sp.max < st.until_max_speed)) {
+      end_stage("criteria");
+      return true;
+    }
+  }
+  if (opt_.progress_every > 0) progress();
+  return true;
+}
+
+void Run::sample() {
+  std::vector<double> row = {s_.time};
+  for (const Observer* o : obs_) o->row(m_, s_, row);
+  series_.row(row);
+}
+
+void Run::progress() {
+  const auto now = Clock::now();
+  if (std::chrono::duration<double>(now - last_progress_).count() < opt_.progress_every) return;
+  last_progress_ = now;
+  const double wall = std::chrono::duration<double>(now - t0_).count();
+  const double steps_s = double(s_.step - step0_) / std::max(wall, 1e-9);
+  const double rate = (s_.time - t_start_) / std::max(wall, 1e-9);
+  // Time left: the rest of the stages with a duration, or what the observers know.
+  double left = 0, total = s_.time;
+  bool bounded = true;
+  for (size_t q = k_; q < plan_.stages.size(); ++q) {
+    const double d = q == k_ ? t_stage_end_ - s_.time : plan_.stages[q].duration;
+    if (std::isfinite(d)) left += d;
+    else bounded = false;
+  }
+  total += left;
+  std::string text;
+  double obs_left = -1;
+  for (const Observer* o : obs_) {
+    const std::string p = o->progress(m_, s_);
+    if (!p.empty()) text += "  " + p;
+    const double l = o->time_left(s_);
+    if (l >= 0) obs_left = obs_left < 0 ? l : std::min(obs_left, l);
+  }
+  std::string eta = "ETA ?";
+  if (bounded) eta = "ETA " + clock_text(left / std::max(rate, 1e-300));
+  else if (obs_left >= 0) eta = "at most " + clock_text(obs_left / std::max(rate, 1e-300));
+  char head[256];
+  if (bounded)
+    std::snprintf(head, sizeof head, "[%s] stage %zu/%zu '%s'  t = %.4g s of %.4g s", plan_.name.c_str(), k_ + 1,
+                  plan_.stages.size(), plan_.stages[k_].name.c_str(), s_.time, total);
+  else
+    std::snprintf(head, sizeof head, "[%s] %s  t = %.4g s", plan_.name.c_str(), plan_.stages[k_].name.c_str(),
+                  s_.time);
+  std::fprintf(stderr, "%s%s  %.3g steps/s  %.3g grain-steps/s  %s\n", head, text.c_str(), steps_s,
+               steps_s * m_.n_grains, eta.c_str());
+}
+
+void Run::finish() {
+  if (finished_) return;
+  finished_ = true;
+  for (Observer* o : obs_) o->finish(m_, s_);
+}
+
+RunReport Run::run() {
+  try {
+    while (advance()) {
+    }
+  } catch (const BlowUpError& e) {
+    rep_.status = "blow_up";
+    rep_.message = e.what();
+    ended_ = true;
+  }
+  finish();
+  rep_.wall_seconds = std::chrono::duration<double>(Clock::now() - t0_).count();
+  rep_.steps = s_.step - step0_;
+  rep_.sim_time = s_.time;
+  if (!opt_.out_dir.empty()) {
+    if (rep_.status == "ok") sample();
+    series_.close();
+  }
+  return rep_;
+}
+
+}  // namespace rt

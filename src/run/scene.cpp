@@ -1,0 +1,102 @@
+// Scene registry, loading and the run of a prepared scene (see scene.hpp).
+#include "regolith_twin/run/scene.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstdlib>
+#include <limits>
+#include <mutex>
+
+#include "regolith_twin/scenes/registry.hpp"
+#include "regolith_twin/scenes/scenario/scenario_scene.hpp"
+
+namespace rt {
+namespace {
+
+struct Registry {
+  std::mutex mu;
+  std::vector<std::shared_ptr<const SceneKind>> kinds;
+  bool builtins = false;
+};
+
+Registry& registry() {
+  static Registry r;
+  std::lock_guard<std::mutex> lk(r.mu);
+  if (!r.builtins) {
+    r.builtins = true;
+    for (auto& k : builtin_scene_kinds()) r.kinds.push_back(k);
+  }
+  return r;
+}
+
+}  // namespace
+
+double Scene::bed_top() const { return std::numeric_limits<double>::infinity(); }
+
+void register_scene_kind(std::shared_ptr<const SceneKind> kind) {
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lk(r.mu);
+  for (auto& k : r.kinds)
+    if (k->name() == kind->name()) {
+      k = std::move(kind);  // a later registration replaces the kind of that name
+      return;
+    }
+  r.kinds.push_back(std::move(kind));
+}
+
+std::vector<std::string> scene_kind_names() {
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lk(r.mu);
+  std::vector<std::string> out;
+  for (const auto& k : r.kinds) out.push_back(k->name());
+  return out;
+}
+
+const SceneKind& scene_kind_of(const YAML::Node& root, const std::string& file) {
+  static const std::shared_ptr<const SceneKind> plain = scenario_kind();
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lk(r.mu);
+  const SceneKind* found = nullptr;
+  if (root && root.IsMap())
+    for (const auto& k : r.kinds)
+      if (root[k->name()]) {
+        if (found)
+          throw InputError(file + ": keys '" + found->name() + "' and '" + k->name() +
+                           "': a scene file names at most one scene kind");
+        found = k.get();
+      }
+  return found ? *found : *plain;
+}
+
+std::unique_ptr<Scene> load_scene(const std::string& file, const std::vector<std::string>& overrides,
+                                  const SceneOptions& opt) {
+  const YAML::Node root = load_document(file, overrides);
+  return scene_kind_of(root, file).prepare(root, file, opt);
+}
+
+RunReport run_scene(const Scene& scene, Model& m, State& s, const SceneRunOptions& opt,
+                    std::unique_ptr<SceneRun>* out_run) {
+  RunOptions ro;
+  ro.out_dir = opt.out_dir;
+  ro.sample_every = scene.sample_every;
+  ro.progress_every = opt.progress_every;
+  ro.stage_snapshots = opt.stage_snapshots;
+  Run run(m, s, scene.plan, ro);
+  std::unique_ptr<SceneRun> sr = scene.begin(run, opt.out_dir);
+  for (Observer* o : sr->observers()) run.add_observer(o);
+  const RunReport rep = run.run();
+  if (!opt.out_dir.empty()) {
+    sr->write_files(opt.out_dir, m, s, rep);
+    sr->write_summary(opt.out_dir + "/summary.json", m, s, rep, opt.threads);
+  }
+  if (out_run) *out_run = std::move(sr);
+  return rep;
+}
+
+std::string default_cache_dir() {
+  const char* env = std::getenv("REGOLITH_CACHE");
+  const char* home = std::getenv("HOME");
+  return env ? env : std::string(home ? home : ".") + "/.cache/regolith_twin";
+}
+
+}  // namespace rt

@@ -1,0 +1,14 @@
+// The built-in scene kinds: a new kind is a folder under src/scenes and a line here.
+#include "regolith_twin/scenes/registry.hpp"
+
+#include "regolith_twin/scenes/landing/landing_scene.hpp"
+
+namespace rt {
+
+std::vector<std::shared_ptr<const SceneKind>> builtin_scene_kinds() {
+  return {
+      landing_kind(),  // MASCOT landing: `landing:` (docs/scenes.md A)
+  };
+}
+
+}  // namespace rt

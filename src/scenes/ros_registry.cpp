@@ -1,0 +1,13 @@
+// The built-in scene kinds' ROS topics: one line per kind that has its own.
+#include "regolith_twin/ros/scene_topics.hpp"
+#include "regolith_twin/scenes/landing/ros_topics.hpp"
+
+namespace rt_ros {
+
+std::vector<std::pair<std::string, SceneTopicsFactory>> builtin_scene_topics() {
+  return {
+      {"landing", make_landing_topics},  // ~landing: the landing outcome (docs/ros.md)
+  };
+}
+
+}  // namespace rt_ros

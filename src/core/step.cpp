@@ -3,6 +3,7 @@
 
 #include <sstream>
 
+#include "regolith_twin/core/field.hpp"
 #include "regolith_twin/core/forces.hpp"
 #include "regolith_twin/core/integrate.hpp"
 #include "regolith_twin/core/neighbours.hpp"
@@ -26,6 +27,7 @@ void prime(const Model& m, State& s) {
   s.hold_body_springs = true;  // body–body points keep the springs they carry in
   try {
     compute_forces(m, s);
+    apply_fields(m, s);  // fields see v(n) here (vel == vel_mid)
   } catch (...) {
     s.hold_body_springs = false;
     throw;
@@ -55,6 +57,7 @@ void step(const Model& m, State& s) {
   else if (body_list_needs_rebuild(m, s))
     build_body_list(m, s);
   compute_forces(m, s);                                            // contacts -> forces
+  apply_fields(m, s);                                              // fields -> forces
   finish_kick(m, s, 0.5 * m.dt);                                   // integrate: half kick
   finish_kick_bodies(m, s, 0.5 * m.dt);
   s.time += m.dt;

@@ -8,7 +8,7 @@
 namespace rt {
 
 // Zero and recompute s.force and s.torque (contacts only; gravity is applied
-// by the integrator) and s.stats.
+// by the integrator, fields by apply_fields in field.hpp) and s.stats.
 void compute_forces(const Model& m, State& s);
 
 }  // namespace rt

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "regolith_twin/core/body.hpp"
+#include "regolith_twin/core/field.hpp"
 #include "regolith_twin/core/types.hpp"
 
 namespace rt {
@@ -120,6 +121,9 @@ struct Model {
   // at a time (a concurrent call throws std::logic_error).
   mutable std::shared_ptr<BodyGeometry> body_geometry;
   Vec3 gravity = Vec3(0, 0, -9.81);    // m/s^2
+  // Per-grain force fields added after the contacts (field.hpp), in this
+  // order. Shared, immutable: copies of the Model share them. Empty: none.
+  std::vector<std::shared_ptr<const Field>> fields;
 
   // --- integration ---
   double dt = 1e-5;                    // s

@@ -1,5 +1,5 @@
 // The time step as a pipeline of stages:
-//   integrate (kick_drift) -> neighbours -> contacts/forces -> integrate (finish_kick) -> guards.
+//   integrate (kick_drift) -> neighbours -> contacts/forces -> fields -> integrate (finish_kick) -> guards.
 #pragma once
 
 #include "regolith_twin/core/state.hpp"

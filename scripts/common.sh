@@ -12,7 +12,7 @@ export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
 
 # Debian packages the build and tests need.
 BUILD_PACKAGES=(g++ make cmake pkg-config catkin libeigen3-dev libyaml-cpp-dev libbullet-dev liburdfdom-dev googletest python3
-  # ROS 1 (ROS.md): the node, its messages and its rostests.
+  # ROS 1 (docs/ros.md): the node, its messages and its rostests.
   ros-core-dev libtf2-ros-dev libtf2-eigen-dev liburdf-dev python3-rostest librostest-dev python3-rosbag librosbag-dev
   ros-message-generation libgeometry-msgs-dev libsensor-msgs-dev libvisualization-msgs-dev libstd-srvs-dev
   libdiagnostic-msgs-dev libros-rosgraph-msgs-dev libtf2-msgs-dev python3-roslaunch

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""MASCOT landing campaign (SCENARIOS.md A): a grid of regolith_land runs.
+"""MASCOT landing campaign (docs/scenes.md A): a grid of regolith_land runs.
 
 Normally started through scripts/sweep (which builds first). Every grid point
 materials x depths x attitudes x angles x repeats is one regolith_land run in
@@ -148,7 +148,7 @@ def run_overrides(a, point, bed):
     """The --set options of one run: the grid point, then the sweep's own --set."""
     mat, depth, att, angle, rep = point
     ov = [f"materials.regolith.preset={mat}"]
-    # The container and the lander take the friction of the grains (SCENARIOS.md A).
+    # The container and the lander take the friction of the grains (docs/scenes.md A).
     if not a.regolith_only:
         ov += [f"materials.container.preset={mat}", f"materials.lander.preset={mat}"]
     ov += [f"landing.rim={depth:g}", f"grains.0.file={bed}", f"landing.attitude={att}",

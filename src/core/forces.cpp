@@ -536,7 +536,7 @@ void wall_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
 // Grain–body contacts of list entries [kb, ke): the grain's force goes to
 // State::force, the reaction to this partition's body accumulators. The body
 // side of the contact moves with the body's velocity at the contact point;
-// lever arm l_j = 0 and R = r_i, as for a wall (MODEL.md §5).
+// lever arm l_j = 0 and R = r_i, as for a wall (docs/model.md §5).
 template <ContactModel M, bool Resist>
 void body_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
   BodyGrainList& bl = s.body_grains;

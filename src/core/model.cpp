@@ -34,7 +34,7 @@ void check_material(const Material& mat) {
   if (!(mat.poisson > -1 && mat.poisson < 0.5)) bad("poisson", "-1 < poisson < 0.5");
 }
 
-// Law constants for a pair of materials a and b (MODEL.md §2–3).
+// Law constants for a pair of materials a and b (docs/model.md §2–3).
 PairLaw make_law(const Model& m, const Material& a, const Material& b) {
   // Restitution: a structure material imposes its own; grains average.
   double eps_n, eps_t;

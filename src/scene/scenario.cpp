@@ -169,7 +169,7 @@ class Reader {
   std::string source_;
 };
 
-// Published materials (MODEL.md §9).
+// Published materials (docs/model.md §9).
 const std::map<std::string, Material>& presets() {
   static const std::map<std::string, Material> p = [] {
     std::map<std::string, Material> m;
@@ -679,7 +679,7 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   } else {
     rd.fail("contact.dt", "missing: the Hertz–Mindlin law needs an explicit dt");
   }
-  // Body–body stiffness of one shape pair (MODEL.md §6); absent: the scene k_n.
+  // Body–body stiffness of one shape pair (docs/model.md §6); absent: the scene k_n.
   m.body_kn = rd.number(c, "contact", "body_kn", 0, 0, kInf, true);
   m.skin = rd.number(c, "contact", "skin", 0, 0, kInf);
   m.partitions = int(rd.integer(c, "contact", "partitions", 4, 1, 256));

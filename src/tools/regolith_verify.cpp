@@ -4,7 +4,7 @@
 //   contact_duration.csv         linear law, measured vs analytic duration and max overlap
 //   convergence_slopes.csv       fitted order of mean |error| vs N per eps_n
 //   chung_ooi_test12.csv         Hertz tests 1-2: max overlap, max force, contact time
-//   chung_ooi_test3.csv          e_out vs e_in (MODEL.md prefactor and calibrated prefactor)
+//   chung_ooi_test3.csv          e_out vs e_in (docs/model.md §3 prefactor and calibrated prefactor)
 //   chung_ooi_test4.csv          oblique impacts: v_t'/v_t, omega R/v, rebound angles
 #include <cmath>
 #include <cstdio>

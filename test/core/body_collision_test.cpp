@@ -1,4 +1,4 @@
-// Body–body contact through Bullet's narrow phase (MODEL.md §6): exact points
+// Body–body contact through Bullet's narrow phase (docs/model.md §6): exact points
 // and depths for resting shapes, the pair's stiffness independent of the
 // number of points, restitution of head-on and face-on impacts, and energy of
 // a box dropped on a rigid plate.

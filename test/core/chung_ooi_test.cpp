@@ -40,7 +40,7 @@ TEST(ChungOoi, Test2ImpactOnRigidPlane) {
   check_elastic(rv::chung_ooi_test2(rv::chung_ooi_magnesium_alloy()));
 }
 
-// e_out against e_in with the damping prefactor of MODEL.md §3.
+// e_out against e_in with the damping prefactor of docs/model.md §3.
 TEST(ChungOoi, Test3RestitutionWithModelPrefactor) {
   for (int k = 2; k <= 10; ++k) {
     const double e = 0.1 * k;
@@ -51,7 +51,7 @@ TEST(ChungOoi, Test3RestitutionWithModelPrefactor) {
 }
 
 // The dimensionless contact equation: converged in its step, and the
-// calibrated prefactor reproduces e exactly. The MODEL.md §3 prefactor turns
+// calibrated prefactor reproduces e exactly. The docs/model.md §3 prefactor turns
 // out to give the same restitution (tension allowed) to 1e-6.
 TEST(HertzDamping, CalibratedPrefactorReproducesRestitution) {
   for (double e : {0.1, 0.2, 0.5, 0.9, 0.99}) {
@@ -86,7 +86,7 @@ TEST(ChungOoi, Test4GrossSlidingRegime) {
   EXPECT_EQ(checked, 11);  // 35 ... 85 degrees
 }
 
-// MODEL.md §3: a wall material with young = 0 is rigid. finalize_model() must
+// docs/model.md §3: a wall material with young = 0 is rigid. finalize_model() must
 // accept it under Hertz–Mindlin (only pairs that involve a grain need E* > 0).
 TEST(HertzRigidWall, FinalizeAcceptsRigidWallMaterial) {
   rt::Model m;

@@ -1,4 +1,4 @@
-// Energy bookkeeping (MODEL.md §2, §4, §7): an elastic, frictionless gas in a
+// Energy bookkeeping (docs/model.md §2, §4, §7): an elastic, frictionless gas in a
 // closed box conserves rt::energy().total() (kinetic + elastic springs); with
 // damping or friction the total energy at contact-free instants never rises.
 //

@@ -1,5 +1,5 @@
 // Friction of a single sphere on a plane wall against closed-form results
-// (MODEL.md §2, §5): sliding-to-rolling transition, constant deceleration by
+// (docs/model.md §2, §5): sliding-to-rolling transition, constant deceleration by
 // rolling resistance at its cap, and the Coulomb limit on an incline.
 #include <gtest/gtest.h>
 

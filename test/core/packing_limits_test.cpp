@@ -1,5 +1,5 @@
 // Friction limits of every contact in a poured, then shaken, packing of the
-// published 'gravel' material (MODEL.md §2, §9): at every step
+// published 'gravel' material (docs/model.md §2, §9): at every step
 //   |F_T| <= mu_s f_n,  |M_R| <= mu_R beta R f_n,  |M_T| <= mu_T beta R mu_s f_n
 // to rounding, with the logged overlap and f_n = max(0, k_n x - C_n u.n)
 // checked against the state, and a good share of contacts at each cap.

@@ -1,4 +1,4 @@
-// Binary normal collision with the linear law (MODEL.md §2, §4, §7): measured
+// Binary normal collision with the linear law (docs/model.md §2, §4, §7): measured
 // restitution, contact duration and maximum overlap against the closed-form
 // solution, as a convergence study over N = 8 ... 240 steps per contact and 50
 // uniformly spaced contact-entry phases, for a grain–grain and a grain–wall

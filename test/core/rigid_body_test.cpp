@@ -1,4 +1,4 @@
-// Rigid bodies (MODEL.md §6): torque-free invariants over 100 rotation
+// Rigid bodies (docs/model.md §6): torque-free invariants over 100 rotation
 // periods, the unstable intermediate axis, grain–shape gap geometry, and
 // grain–body contacts against the wall law and momentum conservation.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Geometry of every analytic wall type (MODEL.md §5) at hand-computed points,
+// Geometry of every analytic wall type (docs/model.md §5) at hand-computed points,
 // including edges and rims, and the static overlap m g / k_n of a grain
 // resting on each of them.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Rigid bodies (MODEL.md §6): static description (shapes, mass, principal
+// Rigid bodies (docs/model.md §6): static description (shapes, mass, principal
 // inertia) and evolving state (pose, momenta, accumulated wrench), the
 // free-rotation integrator and the grain–shape gap functions.
 //

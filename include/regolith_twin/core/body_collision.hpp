@@ -1,4 +1,4 @@
-// Body–body contacts (MODEL.md §6): contact points, normals and depths from
+// Body–body contacts (docs/model.md §6): contact points, normals and depths from
 // Bullet's narrow phase, turned into the spring–dashpot law of the pair.
 // Bullet objects live in Model::body_geometry (see model.hpp); State keeps
 // only plain data (State::body_points), so it can be copied and saved.
@@ -38,7 +38,7 @@
 // sphere or ellipsoid is involved: strictly convex shapes touch at one point,
 // the deepest one is kept). Springs: every point carries a fixed share
 // k_n/n_max and k_t/n_max, so a face contact (n_max points) has the pair's
-// k_n exactly (MODEL.md §6: k/n with n = 4), while an edge (2 points) has
+// k_n exactly (docs/model.md §6: k/n with n = 4), while an edge (2 points) has
 // k_n/2 and a corner k_n/4. Decision: the literal k/n with the current n is
 // not conservative (a point entering at zero depth halves the others'
 // stiffness, one leaving doubles it): a box tumbling onto a plate at ε = 1

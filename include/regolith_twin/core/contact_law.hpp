@@ -1,5 +1,5 @@
 // Contact laws as pure functions of one pair's geometry, kinematics, law
-// constants and spring history (MODEL.md §2–3). They know nothing of lists,
+// constants and spring history (docs/model.md §2–3). They know nothing of lists,
 // walls or threads, so they can be tested on a single pair.
 //
 // Conventions: n points from i to j; x > 0 is the overlap; the relative
@@ -105,7 +105,7 @@ inline LawTerms law_terms(const PairLaw& law, double x, double reff, double sm) 
     t.fn_elastic = (2.0 / 3.0) * t.kn_eff * x;
     t.kt = 8.0 * law.g_star * a;
     t.cn = law.hm_damp * std::sqrt(t.kn_eff) * sm;
-    t.ct = t.cn;  // decision: the same gamma on normal and tangential velocities (MODEL.md §3)
+    t.ct = t.cn;  // decision: the same gamma on normal and tangential velocities (docs/model.md §3)
   }
   return t;
 }

@@ -16,7 +16,7 @@ void kick_drift(const Model& m, State& s, double h, double dt);
 void finish_kick(const Model& m, State& s, double h);
 
 // Rigid bodies: kick–drift with the free-rotation splitting for the
-// orientation (MODEL.md §6), and the closing kick. Run after the grains'
+// orientation (docs/model.md §6), and the closing kick. Run after the grains'
 // stage of the same name (they combine its finiteness check).
 void kick_drift_bodies(const Model& m, State& s, double h, double dt);
 void finish_kick_bodies(const Model& m, State& s, double h);

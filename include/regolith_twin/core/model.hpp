@@ -19,7 +19,7 @@ namespace rt {
 // Contact law family used for every pair in a scene.
 enum class ContactModel { Linear, HertzMindlin };
 
-// A material as published (MODEL.md §9) plus elastic constants for Hertz.
+// A material as published (docs/model.md §9) plus elastic constants for Hertz.
 struct Material {
   std::string name;
   double density = 2430.0;  // kg/m^3 (grains; unused for walls)
@@ -63,7 +63,7 @@ struct PairLaw {
   bool twisting = false;  // twisting resistance active for this pair type
 };
 
-// Analytic, infinite-mass wall shapes (MODEL.md §5).
+// Analytic, infinite-mass wall shapes (docs/model.md §5).
 enum class WallType { Plane, Disk, Cylinder, Cone, Rectangle, SphereShell };
 
 struct Wall {
@@ -110,9 +110,9 @@ struct Model {
 
   // --- environment ---
   std::vector<Wall> walls;
-  std::vector<BodyModel> bodies;       // rigid bodies (MODEL.md §6)
+  std::vector<BodyModel> bodies;       // rigid bodies (docs/model.md §6)
   double body_kn = 0;                  // body–body normal stiffness of one shape pair, N/m (<= 0: the scene k_n);
-                                       // k_t, C_n, C_t of body–body contacts scale with it (MODEL.md §6)
+                                       // k_t, C_n, C_t of body–body contacts scale with it (docs/model.md §6)
   // Bullet shapes of every body shape for the body–body narrow phase: built by
   // build_body_geometry() (called from finalize_model, and lazily by
   // body_body_forces if missing or out of date). Shared by copies of the Model;
@@ -147,7 +147,7 @@ int add_grain(Model& m, double radius, int material, bool fixed = false);
 // Throws InputError on inconsistent parameters.
 void finalize_model(Model& m);
 
-// pkdgrav stiffness rule k_n = m_p (v_max / x_max)^2 (MODEL.md §4).
+// pkdgrav stiffness rule k_n = m_p (v_max / x_max)^2 (docs/model.md §4).
 double kn_rule(double grain_mass, double v_max, double x_max);
 // Time step dt = pi sqrt(m_p / (2 k_n)) / N.
 double dt_rule(double grain_mass, double kn, double steps_per_contact);
@@ -158,7 +158,7 @@ double linear_damping_coef(double k, double eps);
 // Hertz contact duration for an elastic impact at speed v (2.868 (m*^2/(R E*^2 v))^(1/5)).
 double hertz_contact_time(double mstar, double reff, double e_star, double v);
 
-// Steps per contact of every live pair type (MODEL.md §4).
+// Steps per contact of every live pair type (docs/model.md §4).
 struct PairResolution {
   std::string label;      // e.g. "grain-grain (moderate, smallest grains)"
   double contact_time;    // s

@@ -1,4 +1,4 @@
-// Geometry of grain contact with analytic walls (MODEL.md §5): for a sphere
+// Geometry of grain contact with analytic walls (docs/model.md §5): for a sphere
 // of centre p and radius r, the unit normal from the grain towards the wall
 // and the overlap (negative when apart).
 #pragma once

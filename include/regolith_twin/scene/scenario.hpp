@@ -88,7 +88,7 @@ Scenario parse_scenario_text(const std::string& yaml_text, const std::string& so
 int remove_grains(Scenario& sc, State& s, const std::vector<uint8_t>& drop);
 int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vector<GrainGroup>& groups);
 
-// Published materials (MODEL.md §9): gravel, moderate, glass_beads, glass_beads_b.
+// Published materials (docs/model.md §9): gravel, moderate, glass_beads, glass_beads_b.
 bool material_preset(const std::string& name, Material& out);
 
 }  // namespace rt

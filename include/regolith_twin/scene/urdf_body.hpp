@@ -1,4 +1,4 @@
-// Rigid bodies from URDF (MODEL.md §6), parsed with urdfdom.
+// Rigid bodies from URDF (docs/model.md §6), parsed with urdfdom.
 //
 // Every link of the file must hang off one root link through fixed joints: the
 // links merge into one rigid body. Each link contributes its <inertial> (mass,

@@ -1,4 +1,4 @@
-// Analytic verification of binary collisions (MODEL.md §2–4, §7):
+// Analytic verification of binary collisions (docs/model.md §2–4, §7):
 //  * the damped linear normal contact: measured restitution, contact duration
 //    and maximum overlap against the closed-form solution, swept over contact
 //    entry phases and steps per contact (a convergence study);
@@ -21,7 +21,7 @@
 namespace rt::validate {
 
 // ---------------------------------------------------------------------------
-// Linear normal collision (MODEL.md §2, §4).
+// Linear normal collision (docs/model.md §2, §4).
 enum class PairKind { GrainGrain, GrainWall };
 const char* pair_kind_name(PairKind k);
 
@@ -87,7 +87,7 @@ struct HertzElastic {
 };
 HertzElastic hertz_elastic_impact(double mstar, double reff, double e_star, double v);
 
-// Damping prefactor alpha in gamma = alpha sqrt(S_n m*) from MODEL.md §3:
+// Damping prefactor alpha in gamma = alpha sqrt(S_n m*) from docs/model.md §3:
 // 2 sqrt(5/6) |ln e| / sqrt(ln^2 e + pi^2).
 double hertz_damping_prefactor_model(double e);
 // Restitution of an isolated Hertz contact with damping gamma = alpha sqrt(S_n m*)
@@ -153,7 +153,7 @@ struct RestitutionRow {
   double e_in = 0;
   double alpha_model = 0, alpha_calibrated = 0;
   double e_ode_model = 0;     // hertz_restitution(alpha_model): the continuous-time value
-  double e_out_model = 0;     // engine, law prefactor from MODEL.md §3
+  double e_out_model = 0;     // engine, law prefactor from docs/model.md §3
   double e_out_calibrated = 0;  // engine, calibrated prefactor
   double steps_per_contact = 0;
 };

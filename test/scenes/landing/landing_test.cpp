@@ -1,4 +1,4 @@
-// Lander scenes (SCENARIOS.md A): attitude and aim of the placement, and a
+// Lander scenes (docs/scenes.md A): attitude and aim of the placement, and a
 // short landing on a layer of glued grains observed with the outcome
 // definitions (first contact, lift-off of the corners, ratios, ballistic travel).
 #include <gtest/gtest.h>

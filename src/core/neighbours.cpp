@@ -10,14 +10,16 @@
 namespace rt {
 namespace {
 
-// Copy the springs of entries present in both sorted rows; zero the rest.
-template <class List>
-void carry_history(const List& old_list, int os, int oe, const std::vector<int>& old_key, List& nl, int ns,
-                   int ne, const std::vector<int>& new_key) {
+// Copy the springs of the entries present in both sorted ranges, old
+// [os, oe) and new [ns, ne); zero the rest. cmp(o, k) orders old entry o
+// against new entry k by the list's key (< 0, 0, > 0). Every list (pair rows,
+// grain–wall, grain–body) carries its history through this one walk.
+template <class List, class Cmp>
+void carry_history(const List& old_list, int os, int oe, List& nl, int ns, int ne, Cmp cmp) {
   int o = os;
   for (int k = ns; k < ne; ++k) {
-    while (o < oe && old_key[o] < new_key[k]) ++o;
-    if (o < oe && old_key[o] == new_key[k]) {
+    while (o < oe && cmp(o, k) < 0) ++o;
+    if (o < oe && cmp(o, k) == 0) {
       nl.spring_t[k] = old_list.spring_t[o];
       nl.spring_r[k] = old_list.spring_r[o];
       nl.spring_w[k] = old_list.spring_w[o];
@@ -30,6 +32,8 @@ void carry_history(const List& old_list, int os, int oe, const std::vector<int>&
     }
   }
 }
+
+inline int order(long a, long b) { return a < b ? -1 : (a > b ? 1 : 0); }
 
 template <class List>
 void size_history(List& l, int n) {
@@ -147,12 +151,13 @@ void build_pairs(const Model& m, State& s, const Grid& g) {
       const std::vector<int>& in = s.scratch[b].list_partners;
       const int ib = int(long(n) * b / P), ie = int(long(n) * (b + 1) / P);
       std::copy(in.begin(), in.end(), nl.partner.begin() + nl.row_start[ib]);
+      const auto by_partner = [&ol, &nl](int o, int k) { return order(ol.partner[o], nl.partner[k]); };
       for (int i = ib; i < ie; ++i) {
         if (have_old)
-          carry_history(ol, ol.row_start[i], ol.row_start[i + 1], ol.partner, nl, nl.row_start[i],
-                        nl.row_start[i + 1], nl.partner);
+          carry_history(ol, ol.row_start[i], ol.row_start[i + 1], nl, nl.row_start[i], nl.row_start[i + 1],
+                        by_partner);
         else
-          carry_history(nl, 0, 0, nl.partner, nl, nl.row_start[i], nl.row_start[i + 1], nl.partner);
+          carry_history(ol, 0, 0, nl, nl.row_start[i], nl.row_start[i + 1], by_partner);
       }
     }
   }
@@ -175,81 +180,124 @@ void build_walls(const Model& m, State& s) {
     }
   }
   size_history(nl, nl.size());
-  // Entries are sorted by (grain, wall): carry history with a key of grain * nw + wall.
+  // Entries are sorted by (grain, wall): history carried by that key.
   const WallList& ol = s.wall_pairs;
-  int o = 0;
-  const int on = s.lists_valid ? ol.size() : 0;
-  for (int k = 0; k < nl.size(); ++k) {
-    const long key = long(nl.grain[k]) * nw + nl.wall[k];
-    while (o < on && long(ol.grain[o]) * nw + ol.wall[o] < key) ++o;
-    if (o < on && long(ol.grain[o]) * nw + ol.wall[o] == key) {
-      nl.spring_t[k] = ol.spring_t[o];
-      nl.spring_r[k] = ol.spring_r[o];
-      nl.spring_w[k] = ol.spring_w[o];
-      nl.touching[k] = ol.touching[o];
-    } else {
-      nl.spring_t[k].setZero();
-      nl.spring_r[k].setZero();
-      nl.spring_w[k] = 0;
-      nl.touching[k] = 0;
-    }
-  }
+  carry_history(ol, 0, s.lists_valid ? ol.size() : 0, nl, 0, nl.size(), [&ol, &nl](int o, int k) {
+    const int c = order(ol.grain[o], nl.grain[k]);
+    return c != 0 ? c : order(ol.wall[o], nl.wall[k]);
+  });
   std::swap(s.wall_pairs, s.wall_pairs_next);
 }
 
+// Range of grid cells along one axis that holds every grain whose binned
+// coordinate lies in [a, b] (cell units from the grid's low corner). Grains
+// sit in cells floor(c) clamped to the last cell, with c >= 0. False when no
+// cell can hold one.
+bool cell_range(double a, double b, int cells, int& first, int& last) {
+  if (!(b >= 0)) return false;
+  a = std::max(a, 0.0);
+  const double top = cells - 1;
+  first = a >= top ? cells - 1 : int(a);
+  last = b >= top ? cells - 1 : int(b);
+  return true;
+}
+
 // Grain–body candidates: every grain whose gap to a body shape is below the
-// skin, sorted by (grain, body, shape); history carried by that key.
-void build_body_grains(const Model& m, State& s) {
+// skin, sorted by (grain, body, shape); history carried by that key. g must
+// bin the current positions (bin_grains). For each body, only the grains of
+// the cells overlapping its bounding sphere grown by r_max + skin are tested;
+// the grains near one of its shapes are sorted, and the bodies' grains merged
+// in grain order, so the list is the one a test of every grain against every
+// body gives (same entries, order and values).
+void build_body_grains(const Model& m, State& s, const Grid& g) {
   BodyGrainList& nl = s.body_grains_next;
   nl.grain.clear();
   nl.body.clear();
   nl.shape.clear();
   nl.sqrt_mstar.clear();
   const int nb = static_cast<int>(m.bodies.size());
-  for (int i = 0; i < m.n_grains; ++i) {
+  // Scratch (the pair build is done with it): [segment end of each body,
+  // cursor of each body, the sorted candidate grains of each body, a heap of
+  // bodies ordered by the grain at their cursor].
+  std::vector<int>& buf = s.scratch[0].list_partners;
+  buf.assign(2 * size_t(nb), 0);
+  for (int b = 0; b < nb; ++b) {
+    const BodyModel& bm = m.bodies[b];
+    const BodyState& bs = s.bodies[b];
+    const double inv_body = bm.inv_mass();
+    const Quat to_body = bs.q.conjugate();
+    const int n_shapes = static_cast<int>(bm.shapes.size());
+    buf[nb + b] = static_cast<int>(buf.size());
+    // Every grain within reach of the body's centre, with a margin far above
+    // the rounding of the coordinates.
+    const double reach_max = bm.bound_radius + m.max_radius + m.skin;
+    const double h = reach_max + 1e-9 * (reach_max + bs.pos.cwiseAbs().maxCoeff() + g.lo.cwiseAbs().maxCoeff());
+    const Vec3 a = (bs.pos - Vec3::Constant(h) - g.lo) * g.inv_cell, c = (bs.pos + Vec3::Constant(h) - g.lo) * g.inv_cell;
+    int x0, x1, y0, y1, z0, z1;
+    if (cell_range(a.x(), c.x(), g.nx, x0, x1) && cell_range(a.y(), c.y(), g.ny, y0, y1) &&
+        cell_range(a.z(), c.z(), g.nz, z0, z1))
+      for (int z = z0; z <= z1; ++z)
+        for (int y = y0; y <= y1; ++y)
+          for (int x = x0; x <= x1; ++x) {
+            const int cc = (z * g.ny + y) * g.nx + x;
+            for (int q = s.cell_start[cc]; q < s.cell_start[cc + 1]; ++q) {
+              const int i = s.cell_items[q];
+              if (m.grain_inv_mass[i] + inv_body == 0) continue;  // glued grain against an immovable body
+              const double ri = m.grain_radius[i];
+              const Vec3 d = s.pos[i] - bs.pos;
+              const double reach = bm.bound_radius + ri + m.skin;
+              if (d.squaredNorm() > reach * reach) continue;
+              const Vec3 p = to_body * d;
+              for (int k = 0; k < n_shapes; ++k)
+                if (shape_gap(bm, bm.shapes[k], p, ri).overlap > -m.skin) {
+                  buf.push_back(i);  // a candidate: its shapes are listed in the merge below
+                  break;
+                }
+            }
+          }
+    std::sort(buf.begin() + buf[nb + b], buf.end());
+    buf[b] = static_cast<int>(buf.size());
+  }
+  // Merge: take the (grain, body) candidates in grain order, bodies in order
+  // within a grain, and list the body's shapes within reach in order.
+  const int heap0 = static_cast<int>(buf.size());
+  for (int b = 0; b < nb; ++b)
+    if (buf[nb + b] < buf[b]) buf.push_back(b);
+  const auto later = [&buf, nb](int p, int q) {
+    const int gp = buf[buf[nb + p]], gq = buf[buf[nb + q]];
+    return gp != gq ? gp > gq : p > q;
+  };
+  auto heap_end = buf.end();
+  std::make_heap(buf.begin() + heap0, heap_end, later);
+  while (heap_end != buf.begin() + heap0) {
+    std::pop_heap(buf.begin() + heap0, heap_end, later);
+    const int b = *(heap_end - 1);
+    const int i = buf[buf[nb + b]];
+    const BodyModel& bm = m.bodies[b];
+    const BodyState& bs = s.bodies[b];
     const double ri = m.grain_radius[i];
-    for (int b = 0; b < nb; ++b) {
-      const BodyModel& bm = m.bodies[b];
-      const BodyState& bs = s.bodies[b];
-      const double inv = m.grain_inv_mass[i] + bm.inv_mass();
-      if (inv == 0) continue;  // glued grain against an immovable body
-      const Vec3 d = s.pos[i] - bs.pos;
-      const double reach = bm.bound_radius + ri + m.skin;
-      if (d.squaredNorm() > reach * reach) continue;
-      const Vec3 p = bs.q.conjugate() * d;
-      for (int k = 0; k < static_cast<int>(bm.shapes.size()); ++k) {
-        if (shape_gap(bm, bm.shapes[k], p, ri).overlap > -m.skin) {
-          nl.grain.push_back(i);
-          nl.body.push_back(b);
-          nl.shape.push_back(k);
-          nl.sqrt_mstar.push_back(std::sqrt(1.0 / inv));
-        }
+    const double inv = m.grain_inv_mass[i] + bm.inv_mass();
+    const Vec3 p = bs.q.conjugate() * (s.pos[i] - bs.pos);
+    for (int k = 0; k < static_cast<int>(bm.shapes.size()); ++k) {
+      if (shape_gap(bm, bm.shapes[k], p, ri).overlap > -m.skin) {
+        nl.grain.push_back(i);
+        nl.body.push_back(b);
+        nl.shape.push_back(k);
+        nl.sqrt_mstar.push_back(std::sqrt(1.0 / inv));
       }
     }
+    if (++buf[nb + b] < buf[b])
+      std::push_heap(buf.begin() + heap0, heap_end, later);
+    else
+      --heap_end;
   }
   size_history(nl, nl.size());
   const BodyGrainList& ol = s.body_grains;
-  auto less = [](const BodyGrainList& a, int ka, const BodyGrainList& b, int kb) {
-    if (a.grain[ka] != b.grain[kb]) return a.grain[ka] < b.grain[kb];
-    if (a.body[ka] != b.body[kb]) return a.body[ka] < b.body[kb];
-    return a.shape[ka] < b.shape[kb];
-  };
-  int o = 0;
-  const int on = ol.size();
-  for (int k = 0; k < nl.size(); ++k) {
-    while (o < on && less(ol, o, nl, k)) ++o;
-    if (o < on && !less(nl, k, ol, o)) {
-      nl.spring_t[k] = ol.spring_t[o];
-      nl.spring_r[k] = ol.spring_r[o];
-      nl.spring_w[k] = ol.spring_w[o];
-      nl.touching[k] = ol.touching[o];
-    } else {
-      nl.spring_t[k].setZero();
-      nl.spring_r[k].setZero();
-      nl.spring_w[k] = 0;
-      nl.touching[k] = 0;
-    }
-  }
+  carry_history(ol, 0, ol.size(), nl, 0, nl.size(), [&ol, &nl](int o, int k) {
+    int c = order(ol.grain[o], nl.grain[k]);
+    if (c == 0) c = order(ol.body[o], nl.body[k]);
+    return c != 0 ? c : order(ol.shape[o], nl.shape[k]);
+  });
   std::swap(s.body_grains, s.body_grains_next);
   for (int b = 0; b < nb; ++b) {
     s.bodies[b].pos_at_build = s.bodies[b].pos;
@@ -293,7 +341,12 @@ void partition_body_list(const Model& m, State& s) {
   for (int p = 1; p <= P; ++p) s.thread_body_begin[p] = std::max(s.thread_body_begin[p], s.thread_body_begin[p - 1]);
 }
 
-void build_body_list(const Model& m, State& s) { build_body_grains(m, s); }
+void build_body_list(const Model& m, State& s) {
+  // The cells of the last full build are not kept (they may also predate a
+  // checkpoint restore or a moved bed): bin the current positions again.
+  const Grid g = bin_grains(m, s);
+  build_body_grains(m, s, g);
+}
 
 // Split rows into partitions of about equal entry counts; record the grain
 // range each partition writes so merging touches only that range.
@@ -349,7 +402,7 @@ void build_neighbour_lists(const Model& m, State& s) {
   partition_work(m, s);
   s.pos_at_build = s.pos;
   s.stats.max_disp2 = 0;
-  build_body_grains(m, s);
+  build_body_grains(m, s, g);
   s.lists_valid = true;
   s.rebuild_requested = false;
   ++s.rebuilds;

@@ -11,6 +11,7 @@
 #include <map>
 #include <sstream>
 
+#include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/core/walls.hpp"
 #include "regolith_twin/scene/data_file.hpp"
 #include "regolith_twin/scene/generate.hpp"
@@ -556,37 +557,19 @@ bool material_preset(const std::string& name, Material& out) {
 }
 
 int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vector<GrainGroup>& groups) {
-  const int n = m.n_grains;
+  std::vector<int> old_to_new;
+  const int removed = remove_grains(m, s, drop, &old_to_new);
+  if (removed == 0) return 0;
+  // Groups are ranges of grain ids: each keeps its surviving grains.
   std::vector<int> keep;
-  for (int i = 0; i < n; ++i)
-    if (!drop[i]) keep.push_back(i);
-  if (int(keep.size()) == n) return 0;
-  Model nm = m;
-  nm.n_grains = 0;
-  nm.grain_radius.clear();
-  nm.grain_material.clear();
-  nm.grain_fixed.clear();
-  for (int i : keep) add_grain(nm, m.grain_radius[i], m.grain_material[i], m.grain_fixed[i] != 0);
-  finalize_model(nm);
-  State ns = make_state(nm);
-  for (size_t k = 0; k < keep.size(); ++k) {
-    ns.pos[k] = s.pos[keep[k]];
-    ns.vel[k] = s.vel[keep[k]];
-    ns.omega[k] = s.omega[keep[k]];
-  }
-  ns.time = s.time;
-  ns.step = s.step;
-  ns.bodies = s.bodies;
-  ns.wall_on = s.wall_on;
+  for (int i = 0; i < int(old_to_new.size()); ++i)
+    if (old_to_new[i] >= 0) keep.push_back(i);
   for (GrainGroup& g : groups) {
     const int first = int(std::lower_bound(keep.begin(), keep.end(), g.first) - keep.begin());
     const int last = int(std::lower_bound(keep.begin(), keep.end(), g.first + g.count) - keep.begin());
     g.first = first;
     g.count = last - first;
   }
-  const int removed = n - int(keep.size());
-  m = std::move(nm);
-  s = std::move(ns);
   return removed;
 }
 

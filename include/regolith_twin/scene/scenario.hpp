@@ -83,8 +83,9 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source);
 Scenario parse_scenario_text(const std::string& yaml_text, const std::string& source = "<string>");
 
 // Remove the grains flagged in `drop` from the scenario's model and from the
-// state (kinematics kept; contact lists rebuilt at the next step, so springs
-// start afresh). Grain groups shrink accordingly. Returns the number removed.
+// state (rt::remove_grains, core/edit.hpp: survivors keep their kinematics and
+// the springs of the contacts they keep; lists are rebuilt at the next step).
+// Grain groups shrink accordingly. Returns the number removed.
 int remove_grains(Scenario& sc, State& s, const std::vector<uint8_t>& drop);
 int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vector<GrainGroup>& groups);
 

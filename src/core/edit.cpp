@@ -1,0 +1,234 @@
+// Editing the grains of a scene between steps (see edit.hpp): per-grain
+// arrays compacted or extended, contact lists renumbered with their springs.
+#include "regolith_twin/core/edit.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "regolith_twin/core/neighbours.hpp"
+
+namespace rt {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// v[map[i]] = v[i] for every kept i (map[i] <= i, so in place), then shrink.
+template <class T>
+void compact(std::vector<T>& v, const std::vector<int>& map, int kept) {
+  const size_t n = map.size();
+  if (v.size() != n) throw std::logic_error("remove_grains: a per-grain array does not match the grain count");
+  for (size_t i = 0; i < n; ++i)
+    if (map[i] >= 0) v[map[i]] = v[i];
+  v.resize(kept);
+}
+
+// Move the history of entry k to entry out (out <= k).
+template <class List>
+void move_history(List& l, int k, int out) {
+  l.spring_t[out] = l.spring_t[k];
+  l.spring_r[out] = l.spring_r[k];
+  l.spring_w[out] = l.spring_w[k];
+  l.touching[out] = l.touching[k];
+}
+
+template <class List>
+void resize_history(List& l, int n) {
+  l.spring_t.resize(n);
+  l.spring_r.resize(n);
+  l.spring_w.resize(n);
+  l.touching.resize(n);
+}
+
+// Pair list (CSR, rows sorted by partner): rows and partners renumbered,
+// entries with a removed grain dropped. Renumbering keeps the order, so every
+// row stays sorted.
+void compact_pairs(PairList& pl, const std::vector<int>& map, int kept) {
+  const int n = static_cast<int>(map.size());
+  int out = 0, begin = pl.row_start[0];
+  for (int i = 0; i < n; ++i) {
+    const int end = pl.row_start[i + 1];  // read before row map[i] + 1 <= i + 1 is written
+    if (map[i] >= 0) {
+      for (int k = begin; k < end; ++k) {
+        const int j = map[pl.partner[k]];
+        if (j < 0) continue;
+        pl.partner[out] = j;
+        move_history(pl, k, out);
+        ++out;
+      }
+      pl.row_start[map[i] + 1] = out;
+    }
+    begin = end;
+  }
+  pl.row_start[0] = 0;
+  pl.row_start.resize(kept + 1);
+  pl.partner.resize(out);
+  resize_history(pl, out);
+  // owner and sqrt_mstar follow in partition_work.
+}
+
+void clear_pairs(PairList& pl) {
+  pl.row_start.clear();
+  pl.partner.clear();
+  pl.owner.clear();
+  pl.sqrt_mstar.clear();
+  resize_history(pl, 0);
+}
+
+// Grain–wall list sorted by (grain, wall): the order survives renumbering.
+void compact_walls(WallList& wl, const std::vector<int>& map) {
+  const int n = static_cast<int>(map.size());
+  int out = 0;
+  for (int k = 0; k < wl.size(); ++k) {
+    const int g = wl.grain[k];
+    if (g < 0 || g >= n || map[g] < 0) continue;
+    wl.grain[out] = map[g];
+    wl.wall[out] = wl.wall[k];
+    move_history(wl, k, out);
+    ++out;
+  }
+  wl.grain.resize(out);
+  wl.wall.resize(out);
+  resize_history(wl, out);
+}
+
+// Grain–body list sorted by (grain, body, shape): likewise.
+void compact_body_grains(BodyGrainList& bl, const std::vector<int>& map) {
+  const int n = static_cast<int>(map.size());
+  int out = 0;
+  for (int k = 0; k < bl.size(); ++k) {
+    const int g = bl.grain[k];
+    if (g < 0 || g >= n || map[g] < 0) continue;
+    bl.grain[out] = map[g];
+    bl.body[out] = bl.body[k];
+    bl.shape[out] = bl.shape[k];
+    bl.sqrt_mstar[out] = bl.sqrt_mstar[k];
+    move_history(bl, k, out);
+    ++out;
+  }
+  bl.grain.resize(out);
+  bl.body.resize(out);
+  bl.shape.resize(out);
+  bl.sqrt_mstar.resize(out);
+  resize_history(bl, out);
+}
+
+void check_sizes(const Model& m, const State& s, const char* what) {
+  const size_t n = size_t(m.n_grains);
+  for (const std::vector<Vec3>* v : {&s.pos, &s.vel, &s.omega, &s.vel_mid, &s.omega_mid, &s.force, &s.torque, &s.pos_at_build})
+    if (v->size() != n) throw std::logic_error(std::string(what) + ": the state does not match the model's grain count");
+  for (const std::vector<double>* v : {&m.grain_radius, &m.grain_mass, &m.grain_inv_mass, &m.grain_inv_inertia})
+    if (v->size() != n) throw std::logic_error(std::string(what) + ": the model's grain arrays are not finalized");
+  if (m.grain_material.size() != n || m.grain_fixed.size() != n)
+    throw std::logic_error(std::string(what) + ": the model's grain arrays are not finalized");
+}
+
+// The partitions' force buffers (partitions 1..P-1) hold zeros between passes.
+void size_scratch(State& s, int n) {
+  for (size_t p = 1; p < s.scratch.size(); ++p) {
+    s.scratch[p].force.assign(n, Vec3::Zero());
+    s.scratch[p].torque.assign(n, Vec3::Zero());
+  }
+}
+
+// Lists, partitions and pair constants are rebuilt, and forces recomputed,
+// before the next step moves anything (prime, which keeps the springs).
+void request_rebuild(State& s) {
+  s.rebuild_requested = true;
+  s.forces_valid = false;
+}
+
+}  // namespace
+
+int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vector<int>* old_to_new) {
+  const int n = m.n_grains;
+  if (int(drop.size()) != n)
+    throw std::invalid_argument("remove_grains: " + std::to_string(drop.size()) + " flags for " + std::to_string(n) +
+                                " grains");
+  check_sizes(m, s, "remove_grains");
+  std::vector<int> map(n, -1);
+  int kept = 0;
+  for (int i = 0; i < n; ++i)
+    if (!drop[i]) map[i] = kept++;
+  if (old_to_new) *old_to_new = map;
+  if (kept == n) return 0;
+
+  // Model: every per-grain array, then the extremes finalize_model derives.
+  compact(m.grain_radius, map, kept);
+  compact(m.grain_mass, map, kept);
+  compact(m.grain_material, map, kept);
+  compact(m.grain_fixed, map, kept);
+  compact(m.grain_inv_mass, map, kept);
+  compact(m.grain_inv_inertia, map, kept);
+  m.n_grains = kept;
+  m.max_radius = 0;
+  m.min_radius = kept ? 1e300 : 0;
+  for (int i = 0; i < kept; ++i) {
+    m.max_radius = std::max(m.max_radius, m.grain_radius[i]);
+    m.min_radius = std::min(m.min_radius, m.grain_radius[i]);
+  }
+  m.single_grain_material = kept ? m.grain_material[0] : -1;
+  for (int i = 1; i < kept; ++i)
+    if (m.grain_material[i] != m.single_grain_material) m.single_grain_material = -1;
+
+  // State: kinematics, the last forces, the positions of the last list build
+  // (so displacements since then still count towards the next rebuild).
+  for (std::vector<Vec3>* v : {&s.pos, &s.vel, &s.omega, &s.vel_mid, &s.omega_mid, &s.force, &s.torque, &s.pos_at_build})
+    compact(*v, map, kept);
+  size_scratch(s, kept);
+  if (s.stats.max_overlap_grain >= 0 && s.stats.max_overlap_grain < n)
+    s.stats.max_overlap_grain = map[s.stats.max_overlap_grain];
+
+  // Lists with their springs. The pair and wall lists are read by the next
+  // build only while lists_valid; the grain–body list always.
+  if (s.lists_valid && int(s.pairs.row_start.size()) == n + 1) {
+    compact_pairs(s.pairs, map, kept);
+    compact_walls(s.wall_pairs, map);
+  } else {
+    s.lists_valid = false;
+    clear_pairs(s.pairs);
+    compact_walls(s.wall_pairs, map);
+  }
+  compact_body_grains(s.body_grains, map);
+  if (s.lists_valid) partition_work(m, s);
+  partition_body_list(m, s);
+  request_rebuild(s);
+  return n - kept;
+}
+
+int add_grain(Model& m, State& s, double radius, int material, const Vec3& pos, const Vec3& vel, const Vec3& omega) {
+  if (!(radius > 0)) throw InputError("add_grain: radius must be > 0 m");
+  if (material < 0 || material >= m.n_materials()) throw InputError("add_grain: unknown material index");
+  check_sizes(m, s, "add_grain");
+  const int n = m.n_grains;
+  const int i = add_grain(m, radius, material, false);
+  // Mass and inertia as finalize_model derives them.
+  const double mass = 4.0 / 3.0 * kPi * radius * radius * radius * m.materials[material].density;
+  m.grain_mass.push_back(mass);
+  m.grain_inv_mass.push_back(1.0 / mass);
+  m.grain_inv_inertia.push_back(1.0 / (0.4 * mass * radius * radius));
+  m.max_radius = std::max(m.max_radius, radius);
+  m.min_radius = n ? std::min(m.min_radius, radius) : radius;
+  m.single_grain_material = n == 0 || m.single_grain_material == material ? material : -1;
+
+  s.pos.push_back(pos);
+  s.vel.push_back(vel);
+  s.omega.push_back(omega);
+  s.vel_mid.push_back(vel);
+  s.omega_mid.push_back(omega);
+  s.force.push_back(Vec3::Zero());
+  s.torque.push_back(Vec3::Zero());
+  s.pos_at_build.push_back(pos);  // not yet in any list: counts as moved by nothing
+  size_scratch(s, n + 1);
+  // An empty row for the new grain keeps the pair list valid.
+  if (s.lists_valid && int(s.pairs.row_start.size()) == n + 1) {
+    s.pairs.row_start.push_back(s.pairs.row_start.back());
+    partition_work(m, s);
+  } else {
+    s.lists_valid = false;
+  }
+  request_rebuild(s);
+  return i;
+}
+
+}  // namespace rt

@@ -69,7 +69,7 @@ class DropKind : public rt::SceneKind {
   }
 };
 
-// The scene file: 60 grains in a cylinder, a steel ball held above them while
+// The scene file: 30 grains in a cylinder, a steel ball held above them while
 // they settle, then dropped.
 inline const char* kDropYaml = R"(
 name: toy_drop
@@ -87,13 +87,13 @@ grains:
   - name: bed
     material: grain
     radius: {mean: 0.008, sigma: 0.1, cut: 1.0}
-    fill: {shape: cylinder, center: [0, 0, 0], radius: 0.05, z: [0.0, 0.06], count: 60}
-  - {name: ball, material: steel, radius: 0.015, position: [0, 0, 0.12], velocity: [0, 0, 0]}
+    fill: {shape: cylinder, center: [0, 0, 0], radius: 0.05, z: [0.0, 0.08], count: 30}
+  - {name: ball, material: steel, radius: 0.015, position: [0, 0, 0.15], velocity: [0, 0, 0]}
 stages:
-  - {name: settle, duration: 0.15, hold: [ball]}
-  - {name: drop, duration: 0.15}
+  - {name: settle, duration: 0.2, hold: [ball]}
+  - {name: drop, duration: 0.25}
 output: {every: 0.01}
-drop: {plane: 0.1}
+drop: {plane: 0.11}
 )";
 
 // Writes the scene file to path.

@@ -16,6 +16,7 @@
 #include "regolith_twin/core/energy.hpp"
 #include "regolith_twin/core/step.hpp"
 #include "regolith_twin/run/series.hpp"
+#include "regolith_twin/scene/yaml_reader.hpp"
 #include "regolith_twin/scenes/landing/landing_scene.hpp"
 
 namespace rt {
@@ -66,80 +67,45 @@ int largest_box(const BodyModel& b) {
   return best;
 }
 
-// Helpers for the landing block: numbers with ranges, errors naming file and key.
-struct BlockReader {
-  const YAML::Node& n;
-  const std::string& src;
-  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    throw InputError(src + ": key 'landing." + key + "': " + what);
-  }
-  double num(const std::string& key, double dflt, double lo, double hi) const {
-    if (!n[key]) return dflt;
-    double v = 0;
-    try {
-      v = n[key].as<double>();
-    } catch (const YAML::Exception&) {
-      fail(key, "expected a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-    }
-    if (!std::isfinite(v) || v < lo || v > hi)
-      fail(key, "value " + n[key].Scalar() + " out of range (allowed [" + std::to_string(lo) + ", " +
-                    std::to_string(hi) + "])");
-    return v;
-  }
-};
-
 }  // namespace
 
 LandingSpec parse_landing(const YAML::Node& n, const std::string& src) {
   LandingSpec sp;
-  if (!n || !n.IsMap()) throw InputError(src + ": key 'landing': missing or not a mapping");
-  const std::vector<std::string> keys = {"lander", "rim", "container_radius", "attitude", "pitch_deg", "roll_deg",
-                                         "angle_deg", "heading_deg", "speed", "clearance", "aim", "slope_deg", "g",
-                                         "after_liftoff", "max_after_contact", "max_time", "far_ring",
-                                         "sphere_radius", "repeat", "perturb_seed", "sample_every",
-                                         "active_radius", "trapped_hold"};
-  BlockReader rd{n, src};
-  for (const auto& kv : n) {
-    const std::string k = kv.first.as<std::string>();
-    if (std::find(keys.begin(), keys.end(), k) == keys.end()) {
-      std::string list;
-      for (const auto& a : keys) list += (list.empty() ? "" : ", ") + a;
-      rd.fail(k, "unknown key (allowed here: " + list + ")");
-    }
+  const YamlReader rd(src);
+  const std::string p = "landing";
+  if (!n || !n.IsMap()) rd.fail(p, "missing or not a mapping");
+  rd.only(n, p,
+          {"lander", "rim", "container_radius", "attitude", "pitch_deg", "roll_deg", "angle_deg", "heading_deg",
+           "speed", "clearance", "aim", "slope_deg", "g", "after_liftoff", "max_after_contact", "max_time",
+           "far_ring", "sphere_radius", "repeat", "perturb_seed", "sample_every", "active_radius", "trapped_hold"});
+  if (!n["lander"]) rd.fail(p + ".lander", "missing (name of the lander body under 'bodies')");
+  sp.lander = rd.text(n, p, "lander", "");
+  sp.rim = rd.number(n, p, "rim", sp.rim, -1e3, 1e3);
+  sp.container_radius = rd.number(n, p, "container_radius", sp.container_radius, 0.01, 1e3);
+  const std::string a = rd.choice(n, p, "attitude", "BCF", {"Flat", "flat", "BCF", "bcf", "FCF", "fcf"});
+  sp.attitude = (a == "Flat" || a == "flat") ? Attitude::Flat : (a == "BCF" || a == "bcf") ? Attitude::BCF : Attitude::FCF;
+  sp.pitch_deg = rd.number(n, p, "pitch_deg", sp.pitch_deg, 0, 80);
+  sp.roll_deg = rd.number(n, p, "roll_deg", sp.roll_deg, 0, 80);
+  sp.angle_deg = rd.number(n, p, "angle_deg", sp.angle_deg, 0, 85);
+  sp.heading_deg = rd.number(n, p, "heading_deg", sp.heading_deg, -360, 360);
+  sp.speed = rd.number(n, p, "speed", sp.speed, 1e-6, 1e4);
+  sp.clearance = rd.number(n, p, "clearance", sp.clearance, 0, 10);
+  if (const YAML::Node aim = n["aim"]) {
+    if (!aim.IsSequence() || aim.size() != 2) rd.fail(p + ".aim", "expected [x, y] on the trim plane, m");
+    sp.aim = Vec3(rd.number(aim[0], p + ".aim[0]", -1e3, 1e3), rd.number(aim[1], p + ".aim[1]", -1e3, 1e3), 0);
   }
-  if (!n["lander"]) rd.fail("lander", "missing (name of the lander body under 'bodies')");
-  sp.lander = n["lander"].as<std::string>();
-  sp.rim = rd.num("rim", sp.rim, -1e3, 1e3);
-  sp.container_radius = rd.num("container_radius", sp.container_radius, 0.01, 1e3);
-  if (n["attitude"]) {
-    const std::string a = n["attitude"].as<std::string>();
-    if (a == "Flat" || a == "flat") sp.attitude = Attitude::Flat;
-    else if (a == "BCF" || a == "bcf") sp.attitude = Attitude::BCF;
-    else if (a == "FCF" || a == "fcf") sp.attitude = Attitude::FCF;
-    else rd.fail("attitude", "'" + a + "' is not one of: Flat, BCF, FCF");
-  }
-  sp.pitch_deg = rd.num("pitch_deg", sp.pitch_deg, 0, 80);
-  sp.roll_deg = rd.num("roll_deg", sp.roll_deg, 0, 80);
-  sp.angle_deg = rd.num("angle_deg", sp.angle_deg, 0, 85);
-  sp.heading_deg = rd.num("heading_deg", sp.heading_deg, -360, 360);
-  sp.speed = rd.num("speed", sp.speed, 1e-6, 1e4);
-  sp.clearance = rd.num("clearance", sp.clearance, 0, 10);
-  if (n["aim"]) {
-    if (!n["aim"].IsSequence() || n["aim"].size() != 2) rd.fail("aim", "expected [x, y] on the trim plane, m");
-    sp.aim = Vec3(n["aim"][0].as<double>(), n["aim"][1].as<double>(), 0);
-  }
-  sp.slope_deg = rd.num("slope_deg", sp.slope_deg, -60, 60);
-  sp.g = rd.num("g", sp.g, 0, 100);
-  sp.after_liftoff = rd.num("after_liftoff", sp.after_liftoff, 0, 1e4);
-  sp.max_after_contact = rd.num("max_after_contact", sp.max_after_contact, 0, 1e5);
-  sp.max_time = rd.num("max_time", sp.max_time, 0, 1e6);
-  sp.far_ring = rd.num("far_ring", sp.far_ring, 0, 1e3);
-  sp.sphere_radius = rd.num("sphere_radius", sp.sphere_radius, 0, 1e3);
-  sp.repeat = long(rd.num("repeat", 0, 0, 1e6));
-  sp.perturb_seed = (unsigned long)rd.num("perturb_seed", 1, 0, 4e9);
-  sp.sample_every = rd.num("sample_every", sp.sample_every, 1e-6, 1e3);
-  sp.active_radius = rd.num("active_radius", sp.active_radius, 0, 1e3);
-  sp.trapped_hold = rd.num("trapped_hold", sp.trapped_hold, 0, 1e5);
+  sp.slope_deg = rd.number(n, p, "slope_deg", sp.slope_deg, -60, 60);
+  sp.g = rd.number(n, p, "g", sp.g, 0, 100);
+  sp.after_liftoff = rd.number(n, p, "after_liftoff", sp.after_liftoff, 0, 1e4);
+  sp.max_after_contact = rd.number(n, p, "max_after_contact", sp.max_after_contact, 0, 1e5);
+  sp.max_time = rd.number(n, p, "max_time", sp.max_time, 0, 1e6);
+  sp.far_ring = rd.number(n, p, "far_ring", sp.far_ring, 0, 1e3);
+  sp.sphere_radius = rd.number(n, p, "sphere_radius", sp.sphere_radius, 0, 1e3);
+  sp.repeat = rd.integer(n, p, "repeat", 0, 0, 1000000);
+  sp.perturb_seed = (unsigned long)rd.integer(n, p, "perturb_seed", 1, 0, 4000000000L);
+  sp.sample_every = rd.number(n, p, "sample_every", sp.sample_every, 1e-6, 1e3);
+  sp.active_radius = rd.number(n, p, "active_radius", sp.active_radius, 0, 1e3);
+  sp.trapped_hold = rd.number(n, p, "trapped_hold", sp.trapped_hold, 0, 1e5);
   return sp;
 }
 

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "regolith_twin/core/history.hpp"
 #include "regolith_twin/core/neighbours.hpp"
 
 namespace rt {
@@ -23,23 +24,6 @@ void compact(std::vector<T>& v, const std::vector<int>& map, int kept) {
   v.resize(kept);
 }
 
-// Move the history of entry k to entry out (out <= k).
-template <class List>
-void move_history(List& l, int k, int out) {
-  l.spring_t[out] = l.spring_t[k];
-  l.spring_r[out] = l.spring_r[k];
-  l.spring_w[out] = l.spring_w[k];
-  l.touching[out] = l.touching[k];
-}
-
-template <class List>
-void resize_history(List& l, int n) {
-  l.spring_t.resize(n);
-  l.spring_r.resize(n);
-  l.spring_w.resize(n);
-  l.touching.resize(n);
-}
-
 // Pair list (CSR, rows sorted by partner): rows and partners renumbered,
 // entries with a removed grain dropped. Renumbering keeps the order, so every
 // row stays sorted.
@@ -53,7 +37,7 @@ void compact_pairs(PairList& pl, const std::vector<int>& map, int kept) {
         const int j = map[pl.partner[k]];
         if (j < 0) continue;
         pl.partner[out] = j;
-        move_history(pl, k, out);
+        copy_history(pl, k, pl, out);
         ++out;
       }
       pl.row_start[map[i] + 1] = out;
@@ -63,7 +47,7 @@ void compact_pairs(PairList& pl, const std::vector<int>& map, int kept) {
   pl.row_start[0] = 0;
   pl.row_start.resize(kept + 1);
   pl.partner.resize(out);
-  resize_history(pl, out);
+  size_history(pl, out);
   // owner and sqrt_mstar follow in partition_work.
 }
 
@@ -72,7 +56,7 @@ void clear_pairs(PairList& pl) {
   pl.partner.clear();
   pl.owner.clear();
   pl.sqrt_mstar.clear();
-  resize_history(pl, 0);
+  size_history(pl, 0);
 }
 
 // Grain–wall list sorted by (grain, wall): the order survives renumbering.
@@ -84,12 +68,12 @@ void compact_walls(WallList& wl, const std::vector<int>& map) {
     if (g < 0 || g >= n || map[g] < 0) continue;
     wl.grain[out] = map[g];
     wl.wall[out] = wl.wall[k];
-    move_history(wl, k, out);
+    copy_history(wl, k, wl, out);
     ++out;
   }
   wl.grain.resize(out);
   wl.wall.resize(out);
-  resize_history(wl, out);
+  size_history(wl, out);
 }
 
 // Grain–body list sorted by (grain, body, shape): likewise.
@@ -103,14 +87,14 @@ void compact_body_grains(BodyGrainList& bl, const std::vector<int>& map) {
     bl.body[out] = bl.body[k];
     bl.shape[out] = bl.shape[k];
     bl.sqrt_mstar[out] = bl.sqrt_mstar[k];
-    move_history(bl, k, out);
+    copy_history(bl, k, bl, out);
     ++out;
   }
   bl.grain.resize(out);
   bl.body.resize(out);
   bl.shape.resize(out);
   bl.sqrt_mstar.resize(out);
-  resize_history(bl, out);
+  size_history(bl, out);
 }
 
 void check_sizes(const Model& m, const State& s, const char* what) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "regolith_twin/core/history.hpp"
 #include "regolith_twin/core/walls.hpp"
 
 namespace rt {
@@ -19,29 +20,14 @@ void carry_history(const List& old_list, int os, int oe, List& nl, int ns, int n
   int o = os;
   for (int k = ns; k < ne; ++k) {
     while (o < oe && cmp(o, k) < 0) ++o;
-    if (o < oe && cmp(o, k) == 0) {
-      nl.spring_t[k] = old_list.spring_t[o];
-      nl.spring_r[k] = old_list.spring_r[o];
-      nl.spring_w[k] = old_list.spring_w[o];
-      nl.touching[k] = old_list.touching[o];
-    } else {
-      nl.spring_t[k].setZero();
-      nl.spring_r[k].setZero();
-      nl.spring_w[k] = 0;
-      nl.touching[k] = 0;
-    }
+    if (o < oe && cmp(o, k) == 0)
+      copy_history(old_list, o, nl, k);
+    else
+      clear_history(nl, k);
   }
 }
 
 inline int order(long a, long b) { return a < b ? -1 : (a > b ? 1 : 0); }
-
-template <class List>
-void size_history(List& l, int n) {
-  l.spring_t.resize(n);
-  l.spring_r.resize(n);
-  l.spring_w.resize(n);
-  l.touching.resize(n);
-}
 
 // Sort grains into cells of side >= 2 r_max + skin over their bounding box.
 struct Grid {

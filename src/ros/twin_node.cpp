@@ -420,6 +420,24 @@ void TwinNode::publish_contacts() {
     Vec3 point, normal;
   };
   std::vector<Pt> pts;
+  // One pair's message: its wrench, its point count and its deepest points.
+  auto pack = [&](const std::string& body, const std::string& other, const Vec3& f, const Vec3& tq) {
+    regolith_twin::BodyContact bc;
+    bc.body = body;
+    bc.other = other;
+    bc.wrench.force = to_vector(f);
+    bc.wrench.torque = to_vector(tq);
+    bc.count = uint32_t(pts.size());
+    const size_t keep = std::min(pts.size(), size_t(p_.max_contact_points));
+    std::partial_sort(pts.begin(), pts.begin() + keep, pts.end(),
+                      [](const Pt& x, const Pt& y) { return x.depth > y.depth; });
+    for (size_t k = 0; k < keep; ++k) {
+      bc.points.push_back(to_point(pts[k].point));
+      bc.normals.push_back(to_vector(pts[k].normal));
+      bc.depths.push_back(pts[k].depth);
+    }
+    return bc;
+  };
   for (size_t b = 0; b < m.bodies.size(); ++b) {
     const rt::BodyModel& bm = m.bodies[b];
     const rt::BodyState& bs = s.bodies[b];
@@ -442,27 +460,11 @@ void TwinNode::publish_contacts() {
       const rt::ShapeGap g = rt::shape_gap(bm, bm.shapes[bl.shape[k]], p, m.grain_radius[bl.grain[k]]);
       pts.push_back({std::max(0.0, g.overlap), bs.pos + bs.q * g.point, bs.q * g.n});
     }
-    if (pts.empty()) continue;
-    regolith_twin::BodyContact bc;
-    bc.body = bm.name;
-    bc.other = "grains";
-    bc.wrench.force = to_vector(f);
-    bc.wrench.torque = to_vector(tq);
-    bc.count = uint32_t(pts.size());
-    const size_t keep = std::min(pts.size(), size_t(p_.max_contact_points));
-    std::partial_sort(pts.begin(), pts.begin() + keep, pts.end(),
-                      [](const Pt& a, const Pt& c) { return a.depth > c.depth; });
-    for (size_t k = 0; k < keep; ++k) {
-      bc.points.push_back(to_point(pts[k].point));
-      bc.normals.push_back(to_vector(pts[k].normal));
-      bc.depths.push_back(pts[k].depth);
-    }
-    msg.contacts.push_back(bc);
+    if (!pts.empty()) msg.contacts.push_back(pack(bm.name, "grains", f, tq));
   }
   // Body pairs.
   for (size_t a = 0; a < m.bodies.size(); ++a)
     for (size_t b = a + 1; b < m.bodies.size(); ++b) {
-      regolith_twin::BodyContact bc;
       Vec3 f = Vec3::Zero(), tq = Vec3::Zero();
       const Vec3 ca = s.bodies[a].pos;
       pts.clear();
@@ -473,21 +475,7 @@ void TwinNode::publish_contacts() {
         tq += (c.point - ca).cross(sign * c.force_a);
         pts.push_back({c.overlap, c.point, -sign * c.normal});  // into a
       }
-      if (pts.empty()) continue;
-      bc.body = m.bodies[a].name;
-      bc.other = m.bodies[b].name;
-      bc.wrench.force = to_vector(f);
-      bc.wrench.torque = to_vector(tq);
-      bc.count = uint32_t(pts.size());
-      const size_t keep = std::min(pts.size(), size_t(p_.max_contact_points));
-      std::partial_sort(pts.begin(), pts.begin() + keep, pts.end(),
-                        [](const Pt& x, const Pt& y) { return x.depth > y.depth; });
-      for (size_t k = 0; k < keep; ++k) {
-        bc.points.push_back(to_point(pts[k].point));
-        bc.normals.push_back(to_vector(pts[k].normal));
-        bc.depths.push_back(pts[k].depth);
-      }
-      msg.contacts.push_back(bc);
+      if (!pts.empty()) msg.contacts.push_back(pack(m.bodies[a].name, m.bodies[b].name, f, tq));
     }
   contacts_pub_.publish(msg);
   if (contact_markers_pub_.getNumSubscribers() == 0) return;

@@ -115,13 +115,7 @@ struct Scene {
 Scene make_scene(int parallel_min_grains) {
   Scene sc;
   rt::Model& m = sc.m;
-  rt::Material grain;
-  EXPECT_TRUE(rt::material_preset("moderate", grain));
-  m.materials.push_back(grain);
-  rt::Material wall = grain;
-  wall.name = "wall";
-  wall.structure = true;
-  m.materials.push_back(wall);
+  EXPECT_TRUE(rt::test::preset_with_wall(m, "moderate"));
   const double R = 0.05;
   m.walls.push_back(rt::make_plane(Vec3::Zero(), Vec3::UnitZ(), 1));
   m.walls.push_back(rt::make_cylinder(Vec3::Zero(), Vec3::UnitZ(), R, 0.3, true, 1));
@@ -141,7 +135,7 @@ Scene make_scene(int parallel_min_grains) {
   EXPECT_EQ(int(sites.size()), n);
   const std::vector<double> radii = rt::draw_radii(d, n, rng);
   for (int i = 0; i < n; ++i) rt::add_grain(m, radii[i], 0);
-  const double m_p = 4.0 / 3.0 * M_PI * std::pow(d.mean, 3) * grain.density;
+  const double m_p = 4.0 / 3.0 * M_PI * std::pow(d.mean, 3) * m.materials[0].density;
   m.kn = rt::kn_rule(m_p, 1.0, 0.01 * d.mean * (1 - d.sigma));
   m.dt = rt::dt_rule(m_p, m.kn, 30);
   m.parallel_min_grains = parallel_min_grains;
@@ -240,7 +234,7 @@ Scene make_body_scene(int parallel_min_grains) {
   EXPECT_EQ(int(kept.size()), n);
   const std::vector<double> radii = rt::draw_radii(d, n, rng);
   for (int i = 0; i < n; ++i) rt::add_grain(m, radii[i], 0);
-  const double m_p = 4.0 / 3.0 * M_PI * std::pow(d.mean, 3) * grain.density;
+  const double m_p = 4.0 / 3.0 * M_PI * std::pow(d.mean, 3) * m.materials[0].density;
   m.kn = 2e4;
   m.body_kn = 5e4;
   m.dt = rt::dt_rule(m_p, m.kn, 30);

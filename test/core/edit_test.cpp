@@ -35,13 +35,7 @@ struct Scene {
 Scene make_scene(bool extras, bool with_body, std::vector<uint8_t>* extra_index = nullptr) {
   Scene sc;
   rt::Model& m = sc.m;
-  rt::Material grain;
-  EXPECT_TRUE(rt::material_preset("moderate", grain));
-  m.materials.push_back(grain);
-  rt::Material wall = grain;
-  wall.name = "structure";
-  wall.structure = true;
-  m.materials.push_back(wall);
+  EXPECT_TRUE(rt::test::preset_with_wall(m, "moderate"));
   m.walls.push_back(rt::make_plane(Vec3::Zero(), Vec3::UnitZ(), 1));
 
   const double d = 2.02 * kR, dz = d / std::sqrt(2.0);
@@ -84,7 +78,7 @@ Scene make_scene(bool extras, bool with_body, std::vector<uint8_t>* extra_index 
     b.shapes = {box};
     m.bodies.push_back(b);
   }
-  const double m_p = 4.0 / 3.0 * M_PI * std::pow(kR, 3) * grain.density;
+  const double m_p = 4.0 / 3.0 * M_PI * std::pow(kR, 3) * m.materials[0].density;
   m.kn = rt::kn_rule(m_p, 1.0, 0.01 * kR);
   m.dt = rt::dt_rule(m_p, m.kn, 30);
   rt::finalize_model(m);

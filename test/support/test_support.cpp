@@ -1,5 +1,7 @@
 #include "test_support.hpp"
 
+#include "regolith_twin/scene/scenario.hpp"
+
 #include <unistd.h>
 
 #include <cstdio>
@@ -49,6 +51,17 @@ Material simple_material(const std::string& name, double density, double eps_n, 
   m.mu_r = 0;
   m.mu_t = 0;
   return m;
+}
+
+bool preset_with_wall(Model& m, const std::string& preset) {
+  Material grain;
+  if (!material_preset(preset, grain)) return false;
+  m.materials.push_back(grain);
+  Material wall = grain;
+  wall.name = "wall";
+  wall.structure = true;
+  m.materials.push_back(wall);
+  return true;
 }
 
 }  // namespace rt::test

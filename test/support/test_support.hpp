@@ -16,4 +16,8 @@ std::string figure(double v);
 // A material with the given restitution and friction (no rolling/twisting).
 Material simple_material(const std::string& name, double density, double eps_n, double eps_t, double mu_s);
 
+// A published preset (grains, material 0) and the same material as a
+// structure named `wall` (material 1); false if the preset is unknown.
+bool preset_with_wall(Model& m, const std::string& preset);
+
 }  // namespace rt::test

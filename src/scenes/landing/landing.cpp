@@ -367,19 +367,16 @@ double LandingTrackerObserver::time_left(const State& s) const {
 LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& sp, const LandingOptions& opt) {
   LandingScene scene;
   scene.sc.name = "landing";
+  scene.sc.model = m;  // for the summary's run figures
   scene.lander = b;
   scene.spec = scene.run_spec = sp;
   scene.plan = RunPlan::open_ended("landing", "landing");
   scene.sample_every = sp.sample_every;
-  RunOptions runo;
-  runo.out_dir = opt.out_dir;
-  runo.sample_every = sp.sample_every;
-  runo.progress_every = opt.progress_every;
-  Run run(m, s, scene.plan, runo);
-  std::unique_ptr<SceneRun> sr = scene.begin(run, opt.out_dir);
-  for (Observer* o : sr->observers()) run.add_observer(o);
-  const RunReport rep = run.run();
-  if (!opt.out_dir.empty()) sr->write_files(opt.out_dir, m, s, rep);
+  SceneRunOptions ro;
+  ro.out_dir = opt.out_dir;
+  ro.progress_every = opt.progress_every;
+  std::unique_ptr<SceneRun> sr;
+  const RunReport rep = run_scene(scene, m, s, ro, &sr);
   return static_cast<const LandingRun&>(*sr).outcome(rep, true);
 }
 

@@ -605,10 +605,8 @@ void force_pass(const Model& m, State& s) {
     // Grain–grain contacts, one partition at a time. The schedule is static:
     // a thread takes the same partitions and merge blocks every step, and
     // the integrator's static halves nearly coincide with them, so a
-    // thread's grains' data stay in its own core's cache; where the two cores share no cache, handing
-    // partitions to whichever thread is free moved every grain's data from
-    // core to core each step and cost a third of the 2-thread rate
-    // (docs/benchmarks.md). No schedule changes any result.
+    // thread's grains' data stay in its own core's cache (why it matters:
+    // docs/benchmarks.md). No schedule changes any result.
 #pragma omp for schedule(static)
     for (int p = 0; p < P; ++p) {
       ThreadScratch& sc = s.scratch[p];

@@ -31,6 +31,22 @@ Registry& registry() {
 
 }  // namespace
 
+void SceneRun::write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
+                             int threads) const {
+  JsonObject j;
+  j.str("kind", kind_).str("status", rep.status);
+  if (!rep.message.empty()) j.str("message", rep.message);
+  JsonObject run;
+  run.num("grains", m.n_grains).num("steps", double(rep.steps)).num("sim_time", rep.sim_time);
+  run.num("wall_seconds", rep.wall_seconds).num("dt", m.dt).num("kn", m.kn);
+  if (threads > 0) run.num("threads", threads);
+  j.obj("run", run);
+  JsonObject obs;
+  for (Observer* o : const_cast<SceneRun*>(this)->observers()) o->summary(obs);
+  j.obj("observers", obs);
+  j.write(path);
+}
+
 double Scene::bed_top() const { return std::numeric_limits<double>::infinity(); }
 
 void register_scene_kind(std::shared_ptr<const SceneKind> kind) {

@@ -1,8 +1,8 @@
 // A toy scene kind, defined in the tests only: a ball dropped on a bed, the
 // grains above a plane counted. It shows that a kind plugs in from outside
 // the package's sources: its block (`drop: {plane: z}`) is read and checked
-// here, its run counts with the RegionCount observer, and its summary is its
-// own. The node's test adds its topic (test/ros/toy_drop_test.cpp).
+// here, its run counts with the RegionCount observer, and its summary.json is
+// the default one composed from its observers. The node's test adds its topic (test/ros/toy_drop_test.cpp).
 #pragma once
 
 #include <yaml-cpp/yaml.h>
@@ -20,15 +20,8 @@ namespace toy {
 class DropRun : public rt::SceneRun {
  public:
   explicit DropRun(double plane)
-      : above_("above", rt::Vec3(-1e300, -1e300, plane), rt::Vec3(1e300, 1e300, 1e300)) {}
+      : rt::SceneRun("drop"), above_("above", rt::Vec3(-1e300, -1e300, plane), rt::Vec3(1e300, 1e300, 1e300)) {}
   std::vector<rt::Observer*> observers() override { return {&above_}; }
-  void write_summary(const std::string& path, const rt::Model& m, const rt::State& s, const rt::RunReport& rep,
-                     int threads) const override {
-    rt::JsonObject j;
-    j.str("kind", "drop").str("status", rep.status).num("grains_above", double(above_.grains()));
-    j.num("mass_above", above_.mass()).num("t_end", s.time);
-    j.write(path);
-  }
   std::string result_line(const rt::Model& m, const rt::State& s, const rt::RunReport& rep) const override {
     return "drop: " + std::to_string(above_.grains()) + " grains above the plane";
   }

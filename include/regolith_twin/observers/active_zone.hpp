@@ -19,6 +19,9 @@ class ActiveZone : public Observer {
   void prepare(Model& m, State& s) override;
   bool after_step(Model& m, State& s) override;
   void finish(Model& m, State& s) override;
+  void summary(JsonObject& out) const override {
+    out.num("active_radius", radius_).num("active_grains", double(active_)).num("active_edge_rms_speed", edge_rms_);
+  }
 
   long active_grains() const { return active_; }  // free grains at the end
   double edge_rms() const { return edge_rms_; }    // m/s

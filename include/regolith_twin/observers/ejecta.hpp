@@ -14,6 +14,9 @@ class Ejecta : public Observer {
   bool after_step(Model& m, State& s) override;
   void columns(std::vector<std::string>& out) const override { out.push_back("ejected_grains"); }
   void row(const Model& m, const State& s, std::vector<double>& out) const override { out.push_back(double(count_)); }
+  void summary(JsonObject& out) const override {
+    out.num("ejected_grains", double(count_)).num("ejected_volume", volume_);
+  }
 
   long count() const { return count_; }
   double volume() const { return volume_; }  // m^3

@@ -19,6 +19,7 @@ class RegionCount : public Observer {
   }
   void columns(std::vector<std::string>& out) const override;
   void row(const Model& m, const State& s, std::vector<double>& out) const override;
+  void summary(JsonObject& out) const override { out.num(name_ + "_count", double(n_)).num(name_ + "_mass", mass_); }
 
   const std::string& name() const { return name_; }
   long grains() const { return n_; }

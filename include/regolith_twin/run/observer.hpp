@@ -1,15 +1,18 @@
 // Observers: the measurements of a run, behind one small interface. The run
-// loop (run.hpp) calls start() once before the first step, after_step() after
-// every step, asks each observer for its columns of the time series when a row
-// is due, and finish() at the run end. An observer reads the state; it may
-// change the model only where that is its purpose (the active zone freezes and
-// wakes grains). Scene kinds compose their runs from these (docs/scenes.md).
+// loop (run.hpp) calls prepare() and start() once before the first step,
+// after_step() after every step, asks each observer for its columns of the
+// time series when a row is due, and calls finish() at the run end; summary()
+// gives its figures for summary.json. An observer reads the state; it may
+// change the model only where that is its purpose (the active zone freezes
+// and wakes grains). Scene kinds compose their runs from these
+// (docs/architecture.md).
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "regolith_twin/core/state.hpp"
+#include "regolith_twin/run/series.hpp"
 
 namespace rt {
 
@@ -29,6 +32,8 @@ class Observer {
   virtual void row(const Model& m, const State& s, std::vector<double>& out) const {}
   // At the run end (also after a blow-up).
   virtual void finish(Model& m, State& s) {}
+  // Its figures for summary.json (after finish).
+  virtual void summary(JsonObject& out) const {}
   // Text for the progress line ("" for none).
   virtual std::string progress(const Model& m, const State& s) const { return ""; }
   // Simulated time left at most, s, when the observer knows it (< 0: it does not).

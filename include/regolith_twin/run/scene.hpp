@@ -29,12 +29,14 @@ struct SceneOptions {
 // One run of a prepared scene: its observers, and its outputs written from them.
 class SceneRun {
  public:
+  explicit SceneRun(std::string kind = "") : kind_(std::move(kind)) {}
   virtual ~SceneRun() = default;
   // In the order of their series columns.
   virtual std::vector<Observer*> observers() = 0;
-  // summary.json of the run (status and message from the report).
+  // summary.json of the run (status and message from the report). By
+  // default: the kind, status, run figures and every observer's summary().
   virtual void write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
-                             int threads) const = 0;
+                             int threads) const;
   // The kind's other files (summary.json and series.csv aside), written at the end of run_scene.
   virtual void write_files(const std::string& dir, const Model& m, const State& s, const RunReport& rep) const {}
   // Names of the files a run writes, for the "results are in" lines: {label, file name}.
@@ -43,6 +45,9 @@ class SceneRun {
   }
   // One line on the outcome, for the command line and the node's log.
   virtual std::string result_line(const Model& m, const State& s, const RunReport& rep) const = 0;
+
+ private:
+  std::string kind_;
 };
 
 // A scene made ready to run: the scenario as the run starts it, its start

@@ -52,6 +52,15 @@ class Counter : public rt::Observer {
   long end_at_;
 };
 
+// Series rows every 10 steps into a folder of this process, no progress lines.
+rt::RunOptions writing(const std::string& tag, double dt) {
+  rt::RunOptions opt;
+  opt.out_dir = "/tmp/regolith_run_loop" + tag + "_" + std::to_string(::getpid());
+  opt.sample_every = 10 * dt;
+  opt.progress_every = 0;
+  return opt;
+}
+
 int lines(const std::string& path) {
   std::ifstream f(path);
   std::string l;
@@ -65,10 +74,7 @@ int lines(const std::string& path) {
 TEST(RunLoop, AnObserverEndsTheRun) {
   rt::Scenario sc = rt::parse_scenario_text(kPile);
   rt::State s = sc.initial;
-  rt::RunOptions opt;
-  opt.out_dir = "/tmp/regolith_run_loop_" + std::to_string(::getpid());
-  opt.sample_every = 10 * sc.model.dt;
-  opt.progress_every = 0;
+  const rt::RunOptions opt = writing("", sc.model.dt);
   rt::Run run(sc.model, s, rt::RunPlan::of(sc), opt);
   Counter c(25);
   run.add_observer(&c);
@@ -122,10 +128,7 @@ TEST(RunLoop, BlowUpKeepsWhatWasWritten) {
   rt::Scenario sc = rt::parse_scenario_text(kPile);
   sc.model.guards.max_overlap_ratio = 1e-6;  // the first real contact trips it
   rt::State s = sc.initial;
-  rt::RunOptions opt;
-  opt.out_dir = "/tmp/regolith_run_loop_blow_" + std::to_string(::getpid());
-  opt.sample_every = 10 * sc.model.dt;
-  opt.progress_every = 0;
+  const rt::RunOptions opt = writing("_blow", sc.model.dt);
   rt::Run run(sc.model, s, rt::RunPlan::of(sc), opt);
   Counter c(0);
   run.add_observer(&c);

@@ -1,9 +1,12 @@
 // Energy series of a plain scenario (see energy_series.hpp).
 #include "regolith_twin/observers/energy_series.hpp"
 
+#include <limits>
+
 namespace rt {
 
 Vec3 EnergySeries::group_mean(const std::vector<Vec3>& a, const GrainGroup& g) {
+  if (g.count == 0) return Vec3::Constant(std::numeric_limits<double>::quiet_NaN());  // every grain left
   Vec3 c = Vec3::Zero();
   for (int i = g.first; i < g.first + g.count; ++i) c += a[i];
   return c / g.count;

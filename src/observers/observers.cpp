@@ -3,10 +3,12 @@
 #include <cmath>
 #include <fstream>
 
+#include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/core/step.hpp"
 #include "regolith_twin/observers/active_zone.hpp"
 #include "regolith_twin/observers/body_contacts.hpp"
 #include "regolith_twin/observers/ejecta.hpp"
+#include "regolith_twin/observers/escape.hpp"
 #include "regolith_twin/observers/region_count.hpp"
 #include "regolith_twin/observers/surface_map.hpp"
 
@@ -155,6 +157,77 @@ void RegionCount::columns(std::vector<std::string>& out) const {
 void RegionCount::row(const Model& m, const State& s, std::vector<double>& out) const {
   out.push_back(double(n_));
   out.push_back(mass_);
+}
+
+}  // namespace rt
+
+// --- grains leaving the scene ---------------------------------------------------
+
+namespace rt {
+
+bool Escape::leaving(const Model& m, const State& s, std::vector<uint8_t>& drop) {
+  if (s.step % every_ != 0) return false;
+  bool any = false;
+  for (int i = 0; i < m.n_grains; ++i) {
+    const Vec3& p = s.pos[i];
+    if ((p.array() >= lo_.array()).all() && (p.array() <= hi_.array()).all()) continue;
+    // The face crossed farthest, relative to the box size.
+    const Vec3 size = (hi_ - lo_).cwiseMax(Vec3::Constant(1e-300));
+    int face = 0;
+    double worst = -1;
+    for (int d = 0; d < 3; ++d) {
+      const double below = (lo_[d] - p[d]) / size[d], above = (p[d] - hi_[d]) / size[d];
+      if (below > worst) worst = below, face = 2 * d;
+      if (above > worst) worst = above, face = 2 * d + 1;
+    }
+    exits_.push_back({s.time, face, m.grain_mass[i], p, s.vel[i]});
+    mass_ += m.grain_mass[i];
+    face_mass_[face] += m.grain_mass[i];
+    drop[i] = 1;
+    any = true;
+  }
+  return any;
+}
+
+void Escape::columns(std::vector<std::string>& out) const {
+  out.push_back("escaped_grains");
+  out.push_back("escaped_mass");
+}
+
+void Escape::row(const Model& m, const State& s, std::vector<double>& out) const {
+  out.push_back(double(exits_.size()));
+  out.push_back(mass_);
+}
+
+void Escape::finish(Model& m, State& s) {
+  if (log_.empty()) return;
+  std::ofstream f(log_);
+  if (!f) throw InputError(log_ + ": cannot write the log of grains that left");
+  static const char* names[] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
+  f << "t,face,mass,x,y,z,vx,vy,vz\n";
+  f.precision(10);
+  for (const Exit& e : exits_)
+    f << e.t << ',' << names[e.face] << ',' << e.mass << ',' << e.pos.x() << ',' << e.pos.y() << ',' << e.pos.z()
+      << ',' << e.vel.x() << ',' << e.vel.y() << ',' << e.vel.z() << '\n';
+}
+
+void Escape::summary(JsonObject& out) const {
+  out.num("escaped_grains", double(exits_.size())).num("escaped_mass", mass_);
+  out.num("escaped_mass_top", face_mass_[ZMax]);
+}
+
+// --- renumbering after removals -------------------------------------------------
+
+void Ejecta::grains_removed(const std::vector<int>& old_to_new) {
+  renumber_grains(flag_, old_to_new);
+  renumber_grains(above0_, old_to_new);
+}
+
+void ActiveZone::grains_removed(const std::vector<int>& old_to_new) {
+  renumber_grains(inv_mass_, old_to_new);
+  renumber_grains(inv_inertia_, old_to_new);
+  renumber_grains(fixed0_, old_to_new);
+  renumber_grains(woken_, old_to_new);
 }
 
 }  // namespace rt

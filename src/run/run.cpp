@@ -1,6 +1,7 @@
 // The one run loop (see run.hpp).
 #include "regolith_twin/run/run.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -207,6 +208,7 @@ bool Run::advance() {
   }
   bool end = false;
   for (Observer* o : obs_) end = o->after_step(m_, s_) || end;
+  remove_leaving();
   if (end) {
     rep_.ended_by_observer = true;
     end_stage("observer");
@@ -224,6 +226,30 @@ bool Run::advance() {
   }
   if (opt_.progress_every > 0) progress();
   return true;
+}
+
+void Run::remove_leaving() {
+  if (int(drop_.size()) != m_.n_grains) drop_.assign(m_.n_grains, 0);  // all zero between steps
+  bool any = false;
+  for (Observer* o : obs_) any = o->leaving(m_, s_, drop_) || any;
+  if (!any) return;
+  const int n_old = m_.n_grains;
+  remove_grains(m_, s_, drop_, plan_.groups, &old_to_new_);
+  // Held grains follow their new numbers (a held grain that left is let go).
+  std::vector<uint8_t> held(m_.n_grains, 0);
+  size_t k = 0;
+  for (size_t h = 0; h < held_ids_.size(); ++h) {
+    const int j = old_to_new_[held_ids_[h]];
+    if (j < 0) continue;
+    held[j] = 1;
+    held_ids_[k] = j;
+    held_pos_[k++] = held_pos_[h];
+  }
+  held_ids_.resize(k);
+  held_pos_.resize(k);
+  if (int(held_.size()) == n_old) held_ = std::move(held);
+  drop_.assign(m_.n_grains, 0);
+  for (Observer* o : obs_) o->grains_removed(old_to_new_);
 }
 
 void Run::sample() {

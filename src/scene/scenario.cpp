@@ -412,8 +412,10 @@ bool material_preset(const std::string& name, Material& out) {
   return true;
 }
 
-int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vector<GrainGroup>& groups) {
-  std::vector<int> old_to_new;
+int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vector<GrainGroup>& groups,
+                  std::vector<int>* old_to_new_out) {
+  std::vector<int> local;
+  std::vector<int>& old_to_new = old_to_new_out ? *old_to_new_out : local;
   const int removed = remove_grains(m, s, drop, &old_to_new);
   if (removed == 0) return 0;
   // Groups are ranges of grain ids: each keeps its surviving grains.

@@ -26,4 +26,17 @@ int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vec
 // Throws InputError for a radius <= 0 or an unknown material.
 int add_grain(Model& m, State& s, double radius, int material, const Vec3& pos, const Vec3& vel, const Vec3& omega);
 
+// Renumber a per-grain array after remove_grains: v[old_to_new[i]] = v[i]
+// for every kept i (old_to_new[i] <= i, so in place), then shrink.
+template <class T>
+void renumber_grains(std::vector<T>& v, const std::vector<int>& old_to_new) {
+  size_t kept = 0;
+  for (size_t i = 0; i < old_to_new.size() && i < v.size(); ++i)
+    if (old_to_new[i] >= 0) {
+      v[old_to_new[i]] = v[i];
+      ++kept;
+    }
+  v.resize(kept);
+}
+
 }  // namespace rt

@@ -23,6 +23,8 @@ class ActiveZone : public Observer {
     out.num("active_radius", radius_).num("active_grains", double(active_)).num("active_edge_rms_speed", edge_rms_);
   }
 
+  void grains_removed(const std::vector<int>& old_to_new) override;
+
   long active_grains() const { return active_; }  // free grains at the end
   double edge_rms() const { return edge_rms_; }    // m/s
   double radius() const { return radius_; }

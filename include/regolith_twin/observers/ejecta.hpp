@@ -18,6 +18,8 @@ class Ejecta : public Observer {
     out.num("ejected_grains", double(count_)).num("ejected_volume", volume_);
   }
 
+  void grains_removed(const std::vector<int>& old_to_new) override;
+
   long count() const { return count_; }
   double volume() const { return volume_; }  // m^3
   bool ejected(int i) const { return flag_[i] != 0; }

@@ -27,6 +27,12 @@ class Observer {
   virtual void start(const Model& m, const State& s) {}
   // After every step; true ends the run (a landing that has lifted off and flown).
   virtual bool after_step(Model& m, State& s) { return false; }
+  // Grains to take out of the run: set drop[i] = 1 (drop has one zero entry
+  // per grain) and return true if any. Asked after every step, after after_step().
+  virtual bool leaving(const Model& m, const State& s, std::vector<uint8_t>& drop) { return false; }
+  // Grains were removed: old_to_new[i] is grain i's new index, or -1.
+  // Observers that keep per-grain data renumber it here.
+  virtual void grains_removed(const std::vector<int>& old_to_new) {}
   // Names of this observer's columns of series.csv, and their values now.
   virtual void columns(std::vector<std::string>& out) const {}
   virtual void row(const Model& m, const State& s, std::vector<double>& out) const {}

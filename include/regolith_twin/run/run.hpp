@@ -9,8 +9,10 @@
 // one is due, the engine step, the stage's after-step actions (held groups,
 // quick-min, spring release, quench), the observers (any of which may end the
 // run), the stage's end criteria, and a progress line every few wall seconds.
-// A numerical blow-up ends run() with status "blow_up" and keeps what was
-// written. See docs/architecture.md.
+// Observers may take grains out of the run (grains that left the scene): the
+// run removes them after the step, keeping every other contact's springs, and
+// renumbers the groups, held grains and observers' data. A numerical blow-up
+// ends run() with status "blow_up" and keeps what was written. See docs/architecture.md.
 #pragma once
 
 #include <chrono>
@@ -97,6 +99,7 @@ class Run {
 
  private:
   bool settle();  // stage transitions up to the next step; false at the end
+  void remove_leaving();  // grains the observers take out, renumbered everywhere
   void begin_stage();
   void end_stage(const char* reason);
   void sample();
@@ -115,7 +118,8 @@ class Run {
   double t_start_ = 0, t_ramp0_ = 0;
   long step0_ = 0;
   Vec3 g_from_ = Vec3::Zero();
-  std::vector<uint8_t> held_;
+  std::vector<uint8_t> held_, drop_;
+  std::vector<int> old_to_new_;
   std::vector<int> held_ids_;
   std::vector<Vec3> held_pos_;
   StageReport sr_;

@@ -87,7 +87,8 @@ Scenario parse_scenario_text(const std::string& yaml_text, const std::string& so
 // the springs of the contacts they keep; lists are rebuilt at the next step).
 // Grain groups shrink accordingly. Returns the number removed.
 int remove_grains(Scenario& sc, State& s, const std::vector<uint8_t>& drop);
-int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vector<GrainGroup>& groups);
+int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vector<GrainGroup>& groups,
+                  std::vector<int>* old_to_new = nullptr);
 
 // Published materials (docs/model.md §9): gravel, moderate, glass_beads, glass_beads_b.
 bool material_preset(const std::string& name, Material& out);

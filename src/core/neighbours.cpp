@@ -3,6 +3,7 @@
 #include "regolith_twin/core/neighbours.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "regolith_twin/core/history.hpp"
@@ -29,12 +30,29 @@ void carry_history(const List& old_list, int os, int oe, List& nl, int ns, int n
 
 inline int order(long a, long b) { return a < b ? -1 : (a > b ? 1 : 0); }
 
-// Sort grains into cells of side >= 2 r_max + skin over their bounding box.
+// Sort grains into cells of side 2 r_max + skin. Dense: the cells tile the
+// grains' bounding box. When that box would need more than max(4 n, 64)
+// cells (a few grains far from the bed: ejecta), the cells are hashed into a
+// table of at least 2 n buckets instead, so far grains do not coarsen the
+// cells of the bed; a bucket may then hold grains of several cells, which
+// the distance tests sort out. Either way a row finds every partner within
+// the cut-off and is sorted, so the lists are the same.
 struct Grid {
   Vec3 lo;
   double inv_cell;
-  int nx, ny, nz;
+  int nx, ny, nz;     // dense cells per axis (dense grids)
+  bool hashed;
+  uint32_t mask;      // buckets - 1 (hashed grids; a power of two minus one)
 };
+
+// Integer cell coordinate of x along one axis (hashed grids; far grains clamped, still correct).
+inline long cell_coord(double x) { return long(std::clamp(std::floor(x), -1e9, 1e9)); }
+
+inline uint32_t bucket_of(const Grid& g, long x, long y, long z) {
+  const uint64_t h = uint64_t(x) * 0x9E3779B185EBCA87ULL ^ uint64_t(y) * 0xC2B2AE3D27D4EB4FULL ^
+                     uint64_t(z) * 0x165667B19E3779F9ULL;
+  return uint32_t((h ^ (h >> 29)) & g.mask);
+}
 
 Grid bin_grains(const Model& m, State& s) {
   const int n = m.n_grains;
@@ -47,25 +65,35 @@ Grid bin_grains(const Model& m, State& s) {
   double cell = 2 * m.max_radius + m.skin;
   if (!(cell > 0)) cell = 1.0;  // no grains: any cell size
   const long max_cells = std::max<long>(4L * n, 64);
-  Grid g{};
-  for (;;) {
-    const Vec3 ext = (hi - lo) / cell;
-    const double cells = (std::floor(ext.x()) + 1) * (std::floor(ext.y()) + 1) * (std::floor(ext.z()) + 1);
-    if (cells <= max_cells) {
-      g = {lo, 1.0 / cell, int(ext.x()) + 1, int(ext.y()) + 1, int(ext.z()) + 1};
-      break;
-    }
-    cell *= 1.25;  // sparse scene (a grain far away): coarser cells
+  const Vec3 ext = (hi - lo) / cell;
+  const double cells = (std::floor(ext.x()) + 1) * (std::floor(ext.y()) + 1) * (std::floor(ext.z()) + 1);
+  Grid g{lo, 1.0 / cell, 0, 0, 0, false, 0};
+  int ncell = 0;
+  if (cells <= max_cells) {
+    g.nx = int(ext.x()) + 1;
+    g.ny = int(ext.y()) + 1;
+    g.nz = int(ext.z()) + 1;
+    ncell = g.nx * g.ny * g.nz;
+  } else {
+    g.hashed = true;
+    uint32_t buckets = 64;
+    while (buckets < 2u * uint32_t(n)) buckets *= 2;
+    g.mask = buckets - 1;
+    ncell = int(buckets);
   }
-  const int ncell = g.nx * g.ny * g.nz;
   s.cell_start.assign(ncell + 1, 0);
   s.cell_of.resize(n);
   s.cell_items.resize(n);
   for (int i = 0; i < n; ++i) {
     const Vec3 c = (s.pos[i] - g.lo) * g.inv_cell;
-    const int cx = std::min(int(c.x()), g.nx - 1), cy = std::min(int(c.y()), g.ny - 1),
-              cz = std::min(int(c.z()), g.nz - 1);
-    const int id = (cz * g.ny + cy) * g.nx + cx;
+    int id;
+    if (g.hashed) {
+      id = int(bucket_of(g, cell_coord(c.x()), cell_coord(c.y()), cell_coord(c.z())));
+    } else {
+      const int cx = std::min(int(c.x()), g.nx - 1), cy = std::min(int(c.y()), g.ny - 1),
+                cz = std::min(int(c.z()), g.nz - 1);
+      id = (cz * g.ny + cy) * g.nx + cx;
+    }
     s.cell_of[i] = id;
     ++s.cell_start[id + 1];
   }
@@ -78,26 +106,46 @@ Grid bin_grains(const Model& m, State& s) {
   return g;
 }
 
+// The distinct buckets of the cells [x0, x1] x [y0, y1] x [z0, z1] of a
+// hashed grid, sorted, into out (at most 27 for a grain's neighbourhood).
+template <class Out>
+int buckets_of_box(const Grid& g, long x0, long x1, long y0, long y1, long z0, long z1, Out& out) {
+  int k = 0;
+  for (long z = z0; z <= z1; ++z)
+    for (long y = y0; y <= y1; ++y)
+      for (long x = x0; x <= x1; ++x) out[k++] = bucket_of(g, x, y, z);
+  std::sort(out.begin(), out.begin() + k);
+  return int(std::unique(out.begin(), out.begin() + k) - out.begin());
+}
+
 // Partners of row i (j > i within the cut-off, ascending) appended to out.
 void row_partners(const Model& m, const State& s, const Grid& g, int i, std::vector<int>& out) {
   const size_t first = out.size();
   const Vec3 xi = s.pos[i];
   const double ri = m.grain_radius[i];
   const double skin = m.skin;
-  const int c = s.cell_of[i];
-  const int cx = c % g.nx, cy = (c / g.nx) % g.ny, cz = c / (g.nx * g.ny);
-  for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, g.nz - 1); ++z)
-    for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, g.ny - 1); ++y)
-      for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, g.nx - 1); ++x) {
-        const int cc = (z * g.ny + y) * g.nx + x;
-        for (int q = s.cell_start[cc]; q < s.cell_start[cc + 1]; ++q) {
-          const int j = s.cell_items[q];
-          if (j <= i) continue;
-          if (m.grain_fixed[i] && m.grain_fixed[j]) continue;  // glued pairs never interact
-          const double cut = ri + m.grain_radius[j] + skin;
-          if ((s.pos[j] - xi).squaredNorm() < cut * cut) out.push_back(j);
-        }
-      }
+  auto scan = [&](int cc) {
+    for (int q = s.cell_start[cc]; q < s.cell_start[cc + 1]; ++q) {
+      const int j = s.cell_items[q];
+      if (j <= i) continue;
+      if (m.grain_fixed[i] && m.grain_fixed[j]) continue;  // glued pairs never interact
+      const double cut = ri + m.grain_radius[j] + skin;
+      if ((s.pos[j] - xi).squaredNorm() < cut * cut) out.push_back(j);
+    }
+  };
+  if (g.hashed) {
+    const Vec3 c = (xi - g.lo) * g.inv_cell;
+    const long cx = cell_coord(c.x()), cy = cell_coord(c.y()), cz = cell_coord(c.z());
+    std::array<uint32_t, 27> b;
+    const int nb = buckets_of_box(g, cx - 1, cx + 1, cy - 1, cy + 1, cz - 1, cz + 1, b);
+    for (int k = 0; k < nb; ++k) scan(int(b[k]));
+  } else {
+    const int c = s.cell_of[i];
+    const int cx = c % g.nx, cy = (c / g.nx) % g.ny, cz = c / (g.nx * g.ny);
+    for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, g.nz - 1); ++z)
+      for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, g.ny - 1); ++y)
+        for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, g.nx - 1); ++x) scan((z * g.ny + y) * g.nx + x);
+  }
   std::sort(out.begin() + first, out.end());
 }
 
@@ -219,28 +267,44 @@ void build_body_grains(const Model& m, State& s, const Grid& g) {
     const double reach_max = bm.bound_radius + m.max_radius + m.skin;
     const double h = reach_max + 1e-9 * (reach_max + bs.pos.cwiseAbs().maxCoeff() + g.lo.cwiseAbs().maxCoeff());
     const Vec3 a = (bs.pos - Vec3::Constant(h) - g.lo) * g.inv_cell, c = (bs.pos + Vec3::Constant(h) - g.lo) * g.inv_cell;
-    int x0, x1, y0, y1, z0, z1;
-    if (cell_range(a.x(), c.x(), g.nx, x0, x1) && cell_range(a.y(), c.y(), g.ny, y0, y1) &&
-        cell_range(a.z(), c.z(), g.nz, z0, z1))
-      for (int z = z0; z <= z1; ++z)
-        for (int y = y0; y <= y1; ++y)
-          for (int x = x0; x <= x1; ++x) {
-            const int cc = (z * g.ny + y) * g.nx + x;
-            for (int q = s.cell_start[cc]; q < s.cell_start[cc + 1]; ++q) {
-              const int i = s.cell_items[q];
-              if (m.grain_inv_mass[i] + inv_body == 0) continue;  // glued grain against an immovable body
-              const double ri = m.grain_radius[i];
-              const Vec3 d = s.pos[i] - bs.pos;
-              const double reach = bm.bound_radius + ri + m.skin;
-              if (d.squaredNorm() > reach * reach) continue;
-              const Vec3 p = to_body * d;
-              for (int k = 0; k < n_shapes; ++k)
-                if (shape_gap(bm, bm.shapes[k], p, ri).overlap > -m.skin) {
-                  buf.push_back(i);  // a candidate: its shapes are listed in the merge below
-                  break;
-                }
-            }
-          }
+    auto test = [&](int i) {
+      if (m.grain_inv_mass[i] + inv_body == 0) return;  // glued grain against an immovable body
+      const double ri = m.grain_radius[i];
+      const Vec3 d = s.pos[i] - bs.pos;
+      const double reach = bm.bound_radius + ri + m.skin;
+      if (d.squaredNorm() > reach * reach) return;
+      const Vec3 p = to_body * d;
+      for (int k = 0; k < n_shapes; ++k)
+        if (shape_gap(bm, bm.shapes[k], p, ri).overlap > -m.skin) {
+          buf.push_back(i);  // a candidate: its shapes are listed in the merge below
+          return;
+        }
+    };
+    auto scan = [&](int cc) {
+      for (int q = s.cell_start[cc]; q < s.cell_start[cc + 1]; ++q) test(s.cell_items[q]);
+    };
+    if (g.hashed) {
+      // The buckets of the cells in the box, each once; every grain when the
+      // box has more cells than the table has buckets.
+      const long x0 = cell_coord(a.x()), x1 = cell_coord(c.x()), y0 = cell_coord(a.y()), y1 = cell_coord(c.y()),
+                 z0 = cell_coord(a.z()), z1 = cell_coord(c.z());
+      const double box_cells = double(x1 - x0 + 1) * double(y1 - y0 + 1) * double(z1 - z0 + 1);
+      if (box_cells > double(g.mask) + 1) {
+        for (int i = 0; i < m.n_grains; ++i) test(i);
+      } else {
+        static thread_local std::vector<uint32_t> buckets;  // capacity kept between builds
+        buckets.resize(size_t(box_cells));
+        const int nbk = buckets_of_box(g, x0, x1, y0, y1, z0, z1, buckets);
+        for (int k = 0; k < nbk; ++k) scan(int(buckets[k]));
+      }
+    } else {
+      int x0, x1, y0, y1, z0, z1;
+      if (cell_range(a.x(), c.x(), g.nx, x0, x1) && cell_range(a.y(), c.y(), g.ny, y0, y1) &&
+          cell_range(a.z(), c.z(), g.nz, z0, z1))
+        for (int z = z0; z <= z1; ++z)
+          for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) scan((z * g.ny + y) * g.nx + x);
+    }
     std::sort(buf.begin() + buf[nb + b], buf.end());
     buf[b] = static_cast<int>(buf.size());
   }

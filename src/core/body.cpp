@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
+
+#include "regolith_twin/core/mesh_contact.hpp"
 
 namespace rt {
 
@@ -22,6 +25,7 @@ void finalize_body(BodyModel& b) {
       fail("principal moments of inertia violate I_a <= I_b + I_c (not a physical body)");
   }
   if (b.shapes.empty()) fail("has no collision shape");
+  b.surfaces.assign(b.meshes.size(), nullptr);
   double bound = 0;
   for (const Shape& sh : b.shapes) {
     double reach = 0;
@@ -42,6 +46,8 @@ void finalize_body(BodyModel& b) {
       case ShapeType::Mesh:
         if (sh.mesh < 0 || sh.mesh >= static_cast<int>(b.meshes.size())) fail("mesh shape without a mesh");
         for (const Vec3& v : b.meshes[sh.mesh].vertices) reach = std::max(reach, v.norm());
+        if (!b.surfaces[sh.mesh])
+          b.surfaces[sh.mesh] = build_mesh_surface(b.meshes[sh.mesh], "body '" + b.name + "' (link '" + sh.link + "')");
         break;
     }
     bound = std::max(bound, sh.pos.norm() + reach);
@@ -197,7 +203,7 @@ ShapeGap ellipsoid_gap(const Vec3& p, const Vec3& e, double r) {
 
 }  // namespace
 
-ShapeGap shape_gap(const BodyModel& b, const Shape& sh, const Vec3& p, double r) {
+ShapeGap shape_gap(const BodyModel& b, const Shape& sh, const Vec3& p, double r, double reach) {
   const Vec3 ps = sh.rot.conjugate() * (p - sh.pos);  // centre in the shape frame
   ShapeGap g;
   switch (sh.type) {
@@ -205,7 +211,12 @@ ShapeGap shape_gap(const BodyModel& b, const Shape& sh, const Vec3& p, double r)
     case ShapeType::Box: g = box_gap(ps, sh.size, r); break;
     case ShapeType::Cylinder: g = cylinder_gap(ps, sh.size.x(), sh.size.z(), r); break;
     case ShapeType::Ellipsoid: g = ellipsoid_gap(ps, sh.size, r); break;
-    case ShapeType::Mesh: return g;  // grain–mesh contact is not implemented: finalize_model refuses such scenes
+    case ShapeType::Mesh:
+      if (sh.mesh < 0 || sh.mesh >= static_cast<int>(b.surfaces.size()) || !b.surfaces[sh.mesh])
+        throw std::logic_error("shape_gap: body '" + b.name + "' has a mesh shape without a surface (finalize_body)");
+      g = mesh_gap(*b.surfaces[sh.mesh], ps, r, reach);
+      if (g.overlap == -1e300) return g;
+      break;
   }
   g.n = sh.rot * g.n;
   g.point = sh.pos + sh.rot * g.point;

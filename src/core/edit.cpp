@@ -78,8 +78,10 @@ void compact_walls(WallList& wl, const std::vector<int>& map) {
 
 // Grain–body list sorted by (grain, body, shape): likewise.
 void compact_body_grains(BodyGrainList& bl, const std::vector<int>& map) {
+  // Mesh entries keep their slots, moved down to the new numbering (slot
+  // blocks stay in entry order, so each moves to a lower or equal index).
   const int n = static_cast<int>(map.size());
-  int out = 0;
+  int out = 0, slots = 0;
   for (int k = 0; k < bl.size(); ++k) {
     const int g = bl.grain[k];
     if (g < 0 || g >= n || map[g] < 0) continue;
@@ -87,13 +89,21 @@ void compact_body_grains(BodyGrainList& bl, const std::vector<int>& map) {
     bl.body[out] = bl.body[k];
     bl.shape[out] = bl.shape[k];
     bl.sqrt_mstar[out] = bl.sqrt_mstar[k];
-    copy_history(bl, k, bl, out);
+    const int first = bl.mesh_first[k];
+    bl.mesh_first[out] = first >= 0 ? slots : -1;
+    slots += first >= 0 ? kMeshSlots : 0;
+    // copy_history reads the old block at `first` and writes the new one.
+    copy_history<BodyGrainList>(bl, k, bl, out);
+    if (first >= 0)
+      for (int q = 0; q < kMeshSlots; ++q) bl.mesh_slots[bl.mesh_first[out] + q] = bl.mesh_slots[first + q];
     ++out;
   }
   bl.grain.resize(out);
   bl.body.resize(out);
   bl.shape.resize(out);
   bl.sqrt_mstar.resize(out);
+  bl.mesh_first.resize(out);
+  bl.mesh_slots.resize(slots);
   size_history(bl, out);
 }
 

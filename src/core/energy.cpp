@@ -2,9 +2,11 @@
 #include "regolith_twin/core/energy.hpp"
 
 #include <cmath>
+#include <vector>
 
 #include "regolith_twin/core/body_collision.hpp"
 #include "regolith_twin/core/contact_law.hpp"
+#include "regolith_twin/core/mesh_contact.hpp"
 #include "regolith_twin/core/walls.hpp"
 
 namespace rt {
@@ -34,10 +36,33 @@ double elastic_energy(const Model& m, const State& s) {
                                 wl.spring_r[k], wl.spring_w[k]);
   }
   const BodyGrainList& bl = s.body_grains;
+  std::vector<int> tris;
+  std::vector<MeshHit> hits;
   for (int k = 0; k < bl.size(); ++k) {
     const int i = bl.grain[k];
     const BodyModel& bm = m.bodies[bl.body[k]];
     const BodyState& bs = s.bodies[bl.body[k]];
+    if (bl.mesh_first[k] >= 0) {
+      // Every touched feature, with the springs of the slot it holds (the
+      // slot's normal is the one of the last force pass).
+      const Shape& sh = bm.shapes[bl.shape[k]];
+      const Vec3 pb = bs.q.conjugate() * (s.pos[i] - bs.pos);
+      mesh_hits(*bm.surfaces[sh.mesh], sh.rot.conjugate() * (pb - sh.pos), m.grain_radius[i], tris, hits);
+      const MeshSlot* slot = &bl.mesh_slots[bl.mesh_first[k]];
+      const MeshSlot none;
+      for (const MeshHit& h : hits) {
+        const MeshSlot* best = &none;
+        double dot = 0.9;
+        for (int q = 0; q < kMeshSlots; ++q)
+          if (slot[q].touching && slot[q].normal.dot(sh.rot * h.n) > dot) {
+            dot = slot[q].normal.dot(sh.rot * h.n);
+            best = &slot[q];
+          }
+        e += pair_elastic_energy<M>(m.law(m.grain_material[i], bm.material), h.overlap, m.grain_radius[i],
+                                    best->spring_t, best->spring_r, best->spring_w);
+      }
+      continue;
+    }
     const double x =
         shape_gap(bm, bm.shapes[bl.shape[k]], bs.q.conjugate() * (s.pos[i] - bs.pos), m.grain_radius[i]).overlap;
     if (x <= 0) continue;

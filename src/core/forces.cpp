@@ -8,6 +8,7 @@
 
 #include "regolith_twin/core/body_collision.hpp"
 #include "regolith_twin/core/contact_law.hpp"
+#include "regolith_twin/core/mesh_contact.hpp"
 #include "regolith_twin/core/walls.hpp"
 
 namespace rt {
@@ -533,6 +534,123 @@ void wall_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
   }
 }
 
+// One touching contact of grain i with body b: the law with the body side
+// moving with the body's velocity at the contact point (body_entries).
+template <ContactModel M, bool Resist>
+inline void grain_body_contact(const Model& m, State& s, int i, int b, double sqrt_mstar, const Vec3& n, double x,
+                               PairSprings springs, ThreadScratch& sc) {
+  const BodyModel& bm = m.bodies[b];
+  const BodyState& bs = s.bodies[b];
+  const double ri = m.grain_radius[i];
+  PairInput in;
+  in.n = n;
+  in.x = x;
+  in.li = ri - 0.5 * in.x;
+  in.lj = 0;
+  in.reff = ri;
+  in.sqrt_mstar = sqrt_mstar;
+  const Vec3 arm = s.pos[i] + in.li * in.n - bs.pos;  // contact point from the body's centre of mass
+  in.vrel = bs.vel + bs.omega.cross(arm) - s.vel[i];
+  in.wi = s.omega[i];
+  in.wj = bs.omega;
+  in.vrel_mid = bs.vel_mid + bs.omega_mid.cross(arm) - s.vel_mid[i];
+  in.wi_mid = s.omega_mid[i];
+  in.wj_mid = bs.omega_mid;
+  const PairLaw& law = m.law(m.grain_material[i], bm.material);
+  const PairOutput out = pair_contact<M, Resist>(law, in, springs, m.dt);
+  s.force[i] += out.force_i;
+  s.torque[i] += out.torque_i;
+  sc.body_force[b] -= out.force_i;
+  sc.body_torque[b] += out.torque_j - arm.cross(out.force_i);
+  ++sc.contacts;
+  if (s.log_contacts)
+    sc.log.push_back({i, -1000000 - b, in.x, out.fn, out.ft.norm(), out.mr.norm(), std::fabs(out.mt), law.mu_s,
+                      law.mu_r, law.mu_t, law.beta, in.reff});
+  const double ratio = in.x / ri;
+  if (ratio > sc.max_overlap_ratio) {
+    sc.max_overlap_ratio = ratio;
+    sc.max_overlap_grain = i;
+  }
+}
+
+// A contact keeps the slot whose normal (body frame) is within this cosine
+// of its own, best matches first: about 26 degrees, far more than a normal
+// turns in one step while a grain rolls over an edge, far less than the
+// angle between two faces it touches at once in a corner.
+constexpr double kSlotMatch = 0.9;
+
+// Grain–mesh entry k: every touched feature (mesh_hits) is one contact;
+// each takes the history slot whose normal matches its own (docs/model.md
+// §6.3), new contacts take a free slot, slots left unmatched end. A contact
+// beyond kMeshSlots (not met in practice) is evaluated without history.
+template <ContactModel M, bool Resist>
+void mesh_entry(const Model& m, State& s, int k, ThreadScratch& sc) {
+  BodyGrainList& bl = s.body_grains;
+  const int i = bl.grain[k], b = bl.body[k];
+  const BodyModel& bm = m.bodies[b];
+  const BodyState& bs = s.bodies[b];
+  const Shape& sh = bm.shapes[bl.shape[k]];
+  const Vec3 pb = bs.q.conjugate() * (s.pos[i] - bs.pos);  // body frame
+  const int nh = mesh_hits(*bm.surfaces[sh.mesh], sh.rot.conjugate() * (pb - sh.pos), m.grain_radius[i], sc.mesh_tris,
+                           sc.mesh_hits);
+  MeshSlot* slot = &bl.mesh_slots[bl.mesh_first[k]];
+  if (nh == 0) {
+    if (bl.touching[k]) {
+      bl.touching[k] = 0;
+      for (int q = 0; q < kMeshSlots; ++q) slot[q] = MeshSlot{};
+    }
+    return;
+  }
+  bl.touching[k] = 1;
+  MeshHit* hits = sc.mesh_hits.data();
+  for (int h = 0; h < nh; ++h) {
+    hits[h].n = sh.rot * hits[h].n;  // body frame from here on
+    hits[h].slot = -1;
+  }
+  // Match contacts to live slots, best pair first.
+  bool taken[kMeshSlots] = {};
+  for (;;) {
+    double best = kSlotMatch;
+    int bh = -1, bq = -1;
+    for (int h = 0; h < nh; ++h) {
+      if (hits[h].slot >= 0) continue;
+      for (int q = 0; q < kMeshSlots; ++q) {
+        if (taken[q] || !slot[q].touching) continue;
+        const double d = slot[q].normal.dot(hits[h].n);
+        if (d > best) {
+          best = d;
+          bh = h;
+          bq = q;
+        }
+      }
+    }
+    if (bh < 0) break;
+    hits[bh].slot = bq;
+    taken[bq] = true;
+  }
+  for (int q = 0; q < kMeshSlots; ++q)
+    if (!taken[q] && slot[q].touching) slot[q] = MeshSlot{};  // the contact ended
+  for (int h = 0, q = 0; h < nh; ++h) {
+    if (hits[h].slot >= 0) continue;
+    while (q < kMeshSlots && taken[q]) ++q;
+    if (q == kMeshSlots) break;
+    hits[h].slot = q;
+    taken[q] = true;
+  }
+  for (int h = 0; h < nh; ++h) {
+    const MeshHit& hit = hits[h];
+    Vec3 st = Vec3::Zero(), sr = Vec3::Zero();
+    double sw = 0;
+    MeshSlot* sl = hit.slot >= 0 ? &slot[hit.slot] : nullptr;
+    PairSprings springs = sl ? PairSprings{sl->spring_t, sl->spring_r, sl->spring_w} : PairSprings{st, sr, sw};
+    grain_body_contact<M, Resist>(m, s, i, b, bl.sqrt_mstar[k], bs.q * hit.n, hit.overlap, springs, sc);
+    if (sl) {
+      sl->normal = hit.n;
+      sl->touching = 1;
+    }
+  }
+}
+
 // Grain–body contacts of list entries [kb, ke): the grain's force goes to
 // State::force, the reaction to this partition's body accumulators. The body
 // side of the contact moves with the body's velocity at the contact point;
@@ -542,6 +660,10 @@ void body_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
   BodyGrainList& bl = s.body_grains;
   const double dt = m.dt;
   for (int k = kb; k < ke; ++k) {
+    if (bl.mesh_first[k] >= 0) {
+      mesh_entry<M, Resist>(m, s, k, sc);
+      continue;
+    }
     const int i = bl.grain[k], b = bl.body[k];
     const BodyModel& bm = m.bodies[b];
     const BodyState& bs = s.bodies[b];

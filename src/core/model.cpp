@@ -148,12 +148,6 @@ void finalize_model(Model& m) {
   for (auto& b : m.bodies) {
     if (b.material < 0 || b.material >= nm) throw InputError("model: body '" + b.name + "' has an unknown material");
     finalize_body(b);
-    if (n > 0)
-      for (const Shape& sh : b.shapes)
-        if (sh.type == ShapeType::Mesh)
-          throw InputError("model: body '" + b.name + "' (link '" + sh.link +
-                           "') has a mesh collision shape: grain contact with meshes is not supported yet (use box, "
-                           "cylinder, sphere or ellipsoid shapes; meshes work for body–body contact)");
   }
 
   m.pair_law.assign(static_cast<size_t>(nm) * nm, PairLaw{});

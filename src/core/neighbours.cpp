@@ -249,6 +249,8 @@ void build_body_grains(const Model& m, State& s, const Grid& g) {
   nl.body.clear();
   nl.shape.clear();
   nl.sqrt_mstar.clear();
+  nl.mesh_first.clear();
+  int mesh_slots = 0;
   const int nb = static_cast<int>(m.bodies.size());
   // Scratch (the pair build is done with it): [segment end of each body,
   // cursor of each body, the sorted candidate grains of each body, a heap of
@@ -275,7 +277,7 @@ void build_body_grains(const Model& m, State& s, const Grid& g) {
       if (d.squaredNorm() > reach * reach) return;
       const Vec3 p = to_body * d;
       for (int k = 0; k < n_shapes; ++k)
-        if (shape_gap(bm, bm.shapes[k], p, ri).overlap > -m.skin) {
+        if (shape_gap(bm, bm.shapes[k], p, ri, m.skin).overlap > -m.skin) {
           buf.push_back(i);  // a candidate: its shapes are listed in the merge below
           return;
         }
@@ -329,11 +331,14 @@ void build_body_grains(const Model& m, State& s, const Grid& g) {
     const double inv = m.grain_inv_mass[i] + bm.inv_mass();
     const Vec3 p = bs.q.conjugate() * (s.pos[i] - bs.pos);
     for (int k = 0; k < static_cast<int>(bm.shapes.size()); ++k) {
-      if (shape_gap(bm, bm.shapes[k], p, ri).overlap > -m.skin) {
+      if (shape_gap(bm, bm.shapes[k], p, ri, m.skin).overlap > -m.skin) {
         nl.grain.push_back(i);
         nl.body.push_back(b);
         nl.shape.push_back(k);
         nl.sqrt_mstar.push_back(std::sqrt(1.0 / inv));
+        const bool mesh = bm.shapes[k].type == ShapeType::Mesh;
+        nl.mesh_first.push_back(mesh ? mesh_slots : -1);
+        mesh_slots += mesh ? kMeshSlots : 0;
       }
     }
     if (++buf[nb + b] < buf[b])
@@ -342,6 +347,7 @@ void build_body_grains(const Model& m, State& s, const Grid& g) {
       --heap_end;
   }
   size_history(nl, nl.size());
+  nl.mesh_slots.resize(mesh_slots);
   const BodyGrainList& ol = s.body_grains;
   carry_history(ol, 0, ol.size(), nl, 0, nl.size(), [&ol, &nl](int o, int k) {
     int c = order(ol.grain[o], nl.grain[k]);

@@ -65,6 +65,21 @@ State make_state(const Model& m) {
     l->spring_r.reserve(body_cap);
     l->spring_w.reserve(body_cap);
     l->touching.reserve(body_cap);
+    l->mesh_first.reserve(body_cap);
+  }
+  // Grain–mesh contacts: slots for a sixteenth of the grains near a mesh
+  // shape, and per partition the scratch of one grain's query.
+  bool meshes = false;
+  for (const BodyModel& b : m.bodies)
+    for (const Shape& sh : b.shapes) meshes = meshes || sh.type == ShapeType::Mesh;
+  if (meshes && n > 0) {
+    const size_t slot_cap = (size_t(n) / 16 + 64) * kMeshSlots;
+    s.body_grains.mesh_slots.reserve(slot_cap);
+    s.body_grains_next.mesh_slots.reserve(slot_cap);
+    for (auto& sc : s.scratch) {
+      sc.mesh_tris.reserve(256);
+      sc.mesh_hits.reserve(64);
+    }
   }
   // Body–body contact points: every point the shape pairs can have.
   const size_t point_cap = max_body_points(m);

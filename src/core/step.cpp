@@ -37,6 +37,7 @@ void prime(const Model& m, State& s) {
   s.body_grains.spring_r = body_springs.spring_r;
   s.body_grains.spring_w = body_springs.spring_w;
   s.body_grains.touching = body_springs.touching;
+  s.body_grains.mesh_slots = body_springs.mesh_slots;
   s.pairs.spring_t = springs.spring_t;
   s.pairs.spring_r = springs.spring_r;
   s.pairs.spring_w = springs.spring_w;

@@ -16,7 +16,9 @@ namespace rt {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'G', 'T', 'W', 'C', 'K', 'P', 'T'};
-constexpr uint32_t kVersion = 3;  // 3: rigid bodies; 2 (grains only) is still read
+// 4: history slots of grain–mesh contacts; 3 (rigid bodies, no grain–mesh
+// contacts) and 2 (grains only) are still read.
+constexpr uint32_t kVersion = 4;
 
 // Fingerprint of the static grain description a state belongs to.
 uint64_t model_fingerprint(const Model& m) {
@@ -120,6 +122,8 @@ void save_checkpoint(const std::string& path, const Model& m, const State& s) {
   w.vec(s.body_grains.shape);
   w.vec(s.body_grains.sqrt_mstar);
   put_springs(w, s.body_grains);
+  w.vec(s.body_grains.mesh_first);
+  w.vec(s.body_grains.mesh_slots);
   w.vec(s.body_points);
   const uint64_t sum = fnv1a(w.buf.data(), w.buf.size());
   w.pod(sum);
@@ -151,7 +155,7 @@ State load_checkpoint(const std::string& path, const Model& m) {
   char magic[8];
   r.raw(magic, 8);
   const uint32_t version = r.pod<uint32_t>();
-  if (version != kVersion && version != 2)
+  if (version != kVersion && version != 3 && version != 2)
     r.fail("format version " + std::to_string(version) + ", this build reads version " + std::to_string(kVersion));
   const uint64_t n = r.pod<uint64_t>();
   if (n != uint64_t(m.n_grains))
@@ -187,11 +191,24 @@ State load_checkpoint(const std::string& path, const Model& m) {
     r.vec(bl.shape, bl.grain.size());
     r.vec(bl.sqrt_mstar, bl.grain.size());
     get_springs(r, bl, bl.grain.size());
+    if (version >= 4) {
+      r.vec(bl.mesh_first, bl.grain.size());
+      r.vec(bl.mesh_slots);
+    } else {
+      bl.mesh_first.assign(bl.grain.size(), -1);  // version 3 had no grain–mesh contacts
+    }
     r.vec(s.body_points);
-    for (size_t k = 0; k < bl.grain.size(); ++k)
+    int slots = 0;
+    for (size_t k = 0; k < bl.grain.size(); ++k) {
       if (bl.grain[k] < 0 || bl.grain[k] >= m.n_grains || bl.body[k] < 0 || bl.body[k] >= int(nb) ||
           bl.shape[k] < 0 || bl.shape[k] >= int(m.bodies[bl.body[k]].shapes.size()))
         r.fail("grain–body list refers to a grain, body or shape that does not exist");
+      const bool mesh = m.bodies[bl.body[k]].shapes[bl.shape[k]].type == ShapeType::Mesh;
+      if (version < 4 && mesh) r.fail("format version 3 holds no grain–mesh contact history");
+      if (bl.mesh_first[k] != (mesh ? slots : -1)) r.fail("grain–mesh contact history does not match the list");
+      slots += mesh ? kMeshSlots : 0;
+    }
+    if (bl.mesh_slots.size() != size_t(slots)) r.fail("grain–mesh contact history does not match the list");
     for (const auto& pt : s.body_points)
       if (pt.a < 0 || pt.b < 0 || pt.a >= int(nb) || pt.b >= int(nb) || pt.shape_a < 0 || pt.shape_b < 0 ||
           pt.shape_a >= int(m.bodies[pt.a].shapes.size()) || pt.shape_b >= int(m.bodies[pt.b].shapes.size()))

@@ -561,10 +561,14 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
     for (const int b : sc.carve) {
       const BodyModel& bm = m.bodies[b];
       const BodyState& bs = sc.initial.bodies[b];
-      for (int i = 0; i < m.n_grains; ++i)
+      for (int i = 0; i < m.n_grains; ++i) {
+        // Beyond the bounding sphere no shape can overlap (a mesh's gap
+        // searches all its triangles: an inside test needs the nearest one).
+        if ((sc.initial.pos[i] - bs.pos).norm() > bm.bound_radius + m.grain_radius[i]) continue;
         for (const Shape& sh : bm.shapes)
           if (shape_gap(bm, sh, bs.q.conjugate() * (sc.initial.pos[i] - bs.pos), m.grain_radius[i]).overlap > 0)
             drop[i] = 1;
+      }
     }
     sc.carved_grains = remove_grains(sc, sc.initial, drop);
   }

@@ -9,6 +9,8 @@
 #pragma once
 
 #include <array>
+#include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -27,6 +29,9 @@ struct TriangleMesh {
   std::vector<Vec3> vertices;
   std::vector<std::array<int, 3>> triangles;
 };
+
+// Welded mesh, adjacency and BVH for grain contacts (core/mesh_contact.hpp).
+struct MeshSurface;
 
 struct Shape {
   ShapeType type = ShapeType::Box;
@@ -59,6 +64,9 @@ struct BodyModel {
   Quat ref_rot = Quat::Identity();
   std::vector<Shape> shapes;
   std::vector<TriangleMesh> meshes;
+  // Surface of each mesh for grain contacts (mesh_contact.hpp), built by
+  // finalize_body; immutable and shared by copies of the body.
+  std::vector<std::shared_ptr<const MeshSurface>> surfaces;
   std::vector<BodyFrame> frames;  // fixed child frames (reference frame first)
   std::string ref_frame;          // name of the reference frame (URDF base link)
   std::string urdf_file;          // the URDF it was read from ("" for shapes given in a scenario)
@@ -80,7 +88,8 @@ struct BodyState {
   Quat q_at_build = Quat::Identity();
 };
 
-// Bounding radius of the shapes; throws InputError on invalid sizes or mass.
+// Bounding radius of the shapes and the surfaces of the meshes; throws
+// InputError on invalid sizes, mass or meshes.
 void finalize_body(BodyModel& b);
 
 // World inverse inertia R I^-1 R^T of a body at orientation q (zero when fixed).
@@ -105,7 +114,23 @@ struct ShapeGap {
   Vec3 n = Vec3::UnitZ();       // unit normal from the sphere centre towards the shape, body frame
   Vec3 point = Vec3::Zero();    // contact point on the shape surface, body frame
 };
-ShapeGap shape_gap(const BodyModel& b, const Shape& sh, const Vec3& p, double r);
+// A mesh shape gives its nearest surface point (mesh_contact.hpp: mesh_gap),
+// searching only within r + reach (beyond: overlap -1e300); the other shapes
+// ignore reach. Grain–mesh forces use every touched feature (mesh_hits), not
+// this one point.
+ShapeGap shape_gap(const BodyModel& b, const Shape& sh, const Vec3& p, double r,
+                   double reach = std::numeric_limits<double>::infinity());
+
+// One touched feature of a mesh shape (mesh_contact.hpp: mesh_hits).
+struct MeshHit {
+  enum Kind { Face = 0, Edge = 1, Vertex = 2 };
+  Vec3 n = Vec3::UnitZ();       // unit normal from the sphere centre towards the surface
+  Vec3 point = Vec3::Zero();    // closest point of the feature
+  double overlap = 0;           // r - distance, > 0, m
+  int tri = -1;                 // a triangle of the feature (welded surface's numbering)
+  int kind = Face;
+  int slot = -1;                // history slot of the contact (set by the force pass)
+};
 
 // Orientation q of the body's reference frame in the world from a body pose.
 inline Quat reference_rotation(const BodyModel& b, const Quat& q_body) { return q_body * b.ref_rot.conjugate(); }

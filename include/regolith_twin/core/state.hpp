@@ -38,8 +38,24 @@ struct WallList {
   int size() const { return static_cast<int>(grain.size()); }
 };
 
+// History of one contact of a grain with a mesh shape (docs/model.md §6.3).
+// A (grain, mesh shape) entry touches the mesh at up to kMeshSlots features
+// at once; each contact keeps its springs in the slot whose normal (body
+// frame) is closest to its own, so the history follows it across triangles.
+constexpr int kMeshSlots = 4;
+struct MeshSlot {
+  Vec3 normal = Vec3::Zero();   // unit normal from the grain towards the mesh at the last force pass, body frame
+  Vec3 spring_t = Vec3::Zero(); // tangential spring, m
+  Vec3 spring_r = Vec3::Zero(); // rolling spring, rad
+  double spring_w = 0;          // twisting spring, rad
+  int32_t touching = 0;         // 1 while the slot holds a live contact
+  int32_t unused = 0;           // (no padding bytes: checkpoints store slots as bytes)
+};
+
 // Grain–body candidates within r_i + skin of a body shape, sorted by
-// (grain, body, shape), with history.
+// (grain, body, shape), with history. A mesh shape's entry keeps its
+// contacts' springs in kMeshSlots slots (mesh_first) and leaves the entry's
+// own springs at zero; its touching flag is set while any slot is live.
 struct BodyGrainList {
   std::vector<int> grain;       // grain index of each entry
   std::vector<int> body;        // body index
@@ -49,6 +65,8 @@ struct BodyGrainList {
   std::vector<Vec3> spring_r;   // rolling spring, rad
   std::vector<double> spring_w; // twisting spring, rad
   std::vector<uint8_t> touching;
+  std::vector<int> mesh_first;  // first of the entry's kMeshSlots slots in mesh_slots (mesh shapes), else -1
+  std::vector<MeshSlot> mesh_slots;
   int size() const { return static_cast<int>(grain.size()); }
 };
 
@@ -90,6 +108,8 @@ struct ThreadScratch {
   std::vector<Vec3> body_force;    // grain–body reaction on each body, N (n_bodies)
   std::vector<Vec3> body_torque;   // about each body's centre of mass, N m
   std::vector<int> list_partners;  // list build: partners of this block of rows (capacity kept)
+  std::vector<int> mesh_tris;      // grain–mesh contacts: triangles near the grain (capacity kept)
+  std::vector<MeshHit> mesh_hits;  // grain–mesh contacts: touched features (capacity kept)
 };
 
 struct StepStats {

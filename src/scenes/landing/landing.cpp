@@ -177,7 +177,7 @@ void place_lander(const Model& m, State& s, int b, const LandingSpec& sp) {
     for (int i = 0; i < m.n_grains; ++i) {
       const Vec3 p = bs.q.conjugate() * (s.pos[i] - bs.pos);
       for (const Shape& sh : bm.shapes) {
-        const ShapeGap g = shape_gap(bm, sh, p, m.grain_radius[i]);
+        const ShapeGap g = shape_gap(bm, sh, p, m.grain_radius[i], std::max(sp.clearance, 0.0));
         if (g.overlap + sp.clearance > worst) {
           worst = g.overlap + sp.clearance;
           along = std::fabs(vdir.dot(bs.q * g.n));

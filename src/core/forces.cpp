@@ -658,7 +658,6 @@ void mesh_entry(const Model& m, State& s, int k, ThreadScratch& sc) {
 template <ContactModel M, bool Resist>
 void body_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
   BodyGrainList& bl = s.body_grains;
-  const double dt = m.dt;
   for (int k = kb; k < ke; ++k) {
     if (bl.mesh_first[k] >= 0) {
       mesh_entry<M, Resist>(m, s, k, sc);
@@ -674,36 +673,8 @@ void body_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
       continue;
     }
     bl.touching[k] = 1;
-    PairInput in;
-    in.n = bs.q * gap.n;
-    in.x = gap.overlap;
-    in.li = ri - 0.5 * in.x;
-    in.lj = 0;
-    in.reff = ri;
-    in.sqrt_mstar = bl.sqrt_mstar[k];
-    const Vec3 arm = s.pos[i] + in.li * in.n - bs.pos;  // contact point from the body's centre of mass
-    in.vrel = bs.vel + bs.omega.cross(arm) - s.vel[i];
-    in.wi = s.omega[i];
-    in.wj = bs.omega;
-    in.vrel_mid = bs.vel_mid + bs.omega_mid.cross(arm) - s.vel_mid[i];
-    in.wi_mid = s.omega_mid[i];
-    in.wj_mid = bs.omega_mid;
-    const PairLaw& law = m.law(m.grain_material[i], bm.material);
-    const PairOutput out =
-        pair_contact<M, Resist>(law, in, PairSprings{bl.spring_t[k], bl.spring_r[k], bl.spring_w[k]}, dt);
-    s.force[i] += out.force_i;
-    s.torque[i] += out.torque_i;
-    sc.body_force[b] -= out.force_i;
-    sc.body_torque[b] += out.torque_j - arm.cross(out.force_i);
-    ++sc.contacts;
-    if (s.log_contacts)
-      sc.log.push_back({i, -1000000 - b, in.x, out.fn, out.ft.norm(), out.mr.norm(), std::fabs(out.mt), law.mu_s,
-                        law.mu_r, law.mu_t, law.beta, in.reff});
-    const double ratio = in.x / ri;
-    if (ratio > sc.max_overlap_ratio) {
-      sc.max_overlap_ratio = ratio;
-      sc.max_overlap_grain = i;
-    }
+    grain_body_contact<M, Resist>(m, s, i, b, bl.sqrt_mstar[k], bs.q * gap.n, gap.overlap,
+                                  PairSprings{bl.spring_t[k], bl.spring_r[k], bl.spring_w[k]}, sc);
   }
 }
 

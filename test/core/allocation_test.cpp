@@ -190,31 +190,6 @@ rt::BodyModel box_body(const std::string& name, const Vec3& half, bool fixed) {
   return b;
 }
 
-// The closed surface of the box |x_k| <= half_k, each face cut into n x n
-// cells of two triangles, wound outwards.
-rt::TriangleMesh box_mesh(const Vec3& half, int n) {
-  rt::TriangleMesh m;
-  auto face = [&](const Vec3& c0, const Vec3& u, const Vec3& v) {
-    const int base = static_cast<int>(m.vertices.size());
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) m.vertices.push_back(c0 + u * (double(i) / n) + v * (double(j) / n));
-    auto id = [&](int i, int j) { return base + j * (n + 1) + i; };
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-        m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-      }
-  };
-  const Vec3 lo = -half, X(2 * half.x(), 0, 0), Y(0, 2 * half.y(), 0), Z(0, 0, 2 * half.z());
-  face(lo, Y, X);
-  face(lo + Z, X, Y);
-  face(lo, X, Z);
-  face(lo + Y, Z, X);
-  face(lo, Z, Y);
-  face(lo + X, Y, Z);
-  return m;
-}
-
 // 1200 'moderate' grains thrown down between four plane walls onto a fixed
 // plate body, around a free box sliding and spinning on the plate and a
 // second free box that lands on it, under tilted gravity: grain–body
@@ -246,7 +221,7 @@ Scene make_body_scene(int parallel_min_grains, MeshVariant mesh = kNoMesh) {
   if (mesh != kNoMesh) {
     const int keep = mesh == kFixedMeshPlate ? 0 : 1;
     rt::BodyModel b = m.bodies[keep];
-    b.meshes = {box_mesh(b.shapes[0].size, mesh == kFixedMeshPlate ? 8 : 3)};
+    b.meshes = {rt::test::box_mesh(-b.shapes[0].size, b.shapes[0].size, mesh == kFixedMeshPlate ? 8 : 3)};
     b.shapes[0].type = rt::ShapeType::Mesh;
     b.shapes[0].mesh = 0;
     rt::finalize_body(b);  // its surface, for the gaps below

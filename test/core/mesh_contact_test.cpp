@@ -60,34 +60,6 @@ TriangleMesh plane_mesh(int n, double half, bool stl) {
   return d;
 }
 
-// A closed box [lo, hi], each face cut into n x n cells of two triangles,
-// wound outwards.
-TriangleMesh box_mesh(const Vec3& lo, const Vec3& hi, int n) {
-  TriangleMesh m;
-  // Face with outward axis a (sign s): corner c0 and in-plane directions u, v
-  // with u x v along the outward normal.
-  auto face = [&](const Vec3& c0, const Vec3& u, const Vec3& v) {
-    const int base = static_cast<int>(m.vertices.size());
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) m.vertices.push_back(c0 + u * (double(i) / n) + v * (double(j) / n));
-    auto id = [&](int i, int j) { return base + j * (n + 1) + i; };
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-        m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-      }
-  };
-  const Vec3 e = hi - lo;
-  const Vec3 X(e.x(), 0, 0), Y(0, e.y(), 0), Z(0, 0, e.z());
-  face(lo, Y, X);                      // z = lo (normal -z)
-  face(lo + Z, X, Y);                  // z = hi (+z)
-  face(lo, X, Z);                      // y = lo (-y)
-  face(lo + Y, Z, X);                  // y = hi (+y)
-  face(lo, Z, Y);                      // x = lo (-x)
-  face(lo + X, Y, Z);                  // x = hi (+x)
-  return m;
-}
-
 Shape mesh_shape() {
   Shape s;
   s.type = ShapeType::Mesh;
@@ -322,7 +294,7 @@ TEST(MeshContact, OneContactPerFaceInACornerAndOnePerConvexFeature) {
   mb.kn = 1e4;
   mb.dt = 1e-5;
   rt::add_grain(mb, r, 0);
-  add_fixed_mesh(mb, box_mesh(Vec3(-0.01, -0.01, -0.01), Vec3(0.01, 0.01, 0.01), 3));
+  add_fixed_mesh(mb, rt::test::box_mesh(Vec3(-0.01, -0.01, -0.01), Vec3(0.01, 0.01, 0.01), 3));
   rt::finalize_model(mb);
   const double e = (r - delta) / std::sqrt(2.0), v3 = (r - delta) / std::sqrt(3.0);
   for (const Case& c : {Case{"convex edge", Vec3(0.01 + e, 0.003, 0.01 + e), 1, Vec3(f, 0, f) / std::sqrt(2.0)},
@@ -349,7 +321,7 @@ TEST(MeshContact, NoTunnellingThroughAThinPlateAt300MetresPerSecond) {
   m.gravity = Vec3::Zero();
   m.kn = 5.47e6 * (v / 50) * (v / 50);
   rt::add_grain(m, r, 0);
-  add_fixed_mesh(m, box_mesh(Vec3(-0.01, -0.01, -0.0005), Vec3(0.01, 0.01, 0.0005), 4));
+  add_fixed_mesh(m, rt::test::box_mesh(Vec3(-0.01, -0.01, -0.0005), Vec3(0.01, 0.01, 0.0005), 4));
   m.dt = 1;  // set below from the resolution report
   rt::finalize_model(m);
   const double mass = m.grain_mass[0];
@@ -413,7 +385,7 @@ TEST(MeshContact, MeshBoxOnGrainsMatchesTheBoxShape) {
                 (b.mass / 3);
     b.material = 1;
     if (mesh) {
-      b.meshes = {box_mesh(-half, half, 2)};
+      b.meshes = {rt::test::box_mesh(-half, half, 2)};
       b.shapes = {mesh_shape()};
     } else {
       Shape s;

@@ -64,4 +64,29 @@ bool preset_with_wall(Model& m, const std::string& preset) {
   return true;
 }
 
+TriangleMesh box_mesh(const Vec3& lo, const Vec3& hi, int n) {
+  TriangleMesh m;
+  // Face with corner c0 and in-plane directions u, v, u x v along the outward normal.
+  auto face = [&](const Vec3& c0, const Vec3& u, const Vec3& v) {
+    const int base = static_cast<int>(m.vertices.size());
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) m.vertices.push_back(c0 + u * (double(i) / n) + v * (double(j) / n));
+    auto id = [&](int i, int j) { return base + j * (n + 1) + i; };
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+        m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+      }
+  };
+  const Vec3 e = hi - lo;
+  const Vec3 X(e.x(), 0, 0), Y(0, e.y(), 0), Z(0, 0, e.z());
+  face(lo, Y, X);      // z = lo (normal -z)
+  face(lo + Z, X, Y);  // z = hi (+z)
+  face(lo, X, Z);      // y = lo (-y)
+  face(lo + Y, Z, X);  // y = hi (+y)
+  face(lo, Z, Y);      // x = lo (-x)
+  face(lo + X, Y, Z);  // x = hi (+x)
+  return m;
+}
+
 }  // namespace rt::test

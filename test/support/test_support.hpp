@@ -20,4 +20,8 @@ Material simple_material(const std::string& name, double density, double eps_n, 
 // structure named `wall` (material 1); false if the preset is unknown.
 bool preset_with_wall(Model& m, const std::string& preset);
 
+// The closed box [lo, hi] as a triangle mesh, each face cut into n x n
+// cells of two triangles, wound outwards (vertices shared within a face).
+TriangleMesh box_mesh(const Vec3& lo, const Vec3& hi, int n);
+
 }  // namespace rt::test

@@ -139,6 +139,7 @@ int run_cli(int argc, char** argv, const char* tool) {
       std::printf("checkpoint:  %s\n", a.checkpoint.c_str());
     }
     std::printf("%s\n", run->result_line(m, s, rep).c_str());
+    std::printf("%-12s %s\n", "scene kind:", scene->kind().c_str());
     for (const auto& [label, name] : run->files()) {
       const std::string l = label + ":";
       std::printf("%-12s %s/%s\n", l.c_str(), a.out.c_str(), name.c_str());

@@ -41,7 +41,7 @@ class Twin {
 
   // The scene, its kind, and the current run (its observers).
   const Scene& scene() const { return *scene_; }
-  const std::string kind() const { return scene_->kind(); }
+  std::string kind() const { return scene_->kind(); }
   const SceneRun& run() const { return *scene_run_; }
   // The run's report so far (steps counted from the start state).
   RunReport report() const;

@@ -42,6 +42,30 @@ class Writer {
   std::string buf;
 };
 
+// Body states copied field by field into zeroed storage: a BodyState has
+// padding bytes (a Quat is 16-byte aligned), and equal states must give
+// equal files.
+std::vector<BodyState> zero_padded(const std::vector<BodyState>& in) {
+  std::vector<BodyState> out(in.size());
+  for (size_t k = 0; k < in.size(); ++k) {
+    BodyState& o = out[k];
+    const BodyState& b = in[k];
+    std::memset(static_cast<void*>(&o), 0, sizeof o);
+    o.pos = b.pos;
+    o.q = b.q;
+    o.vel = b.vel;
+    o.omega = b.omega;
+    o.vel_mid = b.vel_mid;
+    o.omega_mid = b.omega_mid;
+    o.ang_mom = b.ang_mom;
+    o.force = b.force;
+    o.torque = b.torque;
+    o.pos_at_build = b.pos_at_build;
+    o.q_at_build = b.q_at_build;
+  }
+  return out;
+}
+
 class Reader {
  public:
   Reader(const std::string& path, const std::string& data) : path_(path), data_(data) {}
@@ -114,7 +138,7 @@ void save_checkpoint(const std::string& path, const Model& m, const State& s) {
   put_springs(w, s.wall_pairs);
   // Rigid bodies: states, grain–body list with history, body–body points.
   w.pod<uint64_t>(m.bodies.size());
-  w.vec(s.bodies);
+  w.vec(zero_padded(s.bodies));
   w.pod(s.body_list_grain_disp);
   w.pod<int64_t>(s.body_rebuilds);
   w.vec(s.body_grains.grain);

@@ -98,7 +98,7 @@ RunReport run_scene(const Scene& scene, Model& m, State& s, const SceneRunOption
   ro.progress_every = opt.progress_every;
   ro.stage_snapshots = opt.stage_snapshots;
   Run run(m, s, scene.plan, ro);
-  std::unique_ptr<SceneRun> sr = scene.begin(run, opt.out_dir);
+  std::unique_ptr<SceneRun> sr = scene.begin(run);
   for (Observer* o : sr->observers()) run.add_observer(o);
   const RunReport rep = run.run();
   if (!opt.out_dir.empty()) {

@@ -34,7 +34,7 @@ class DropRun : public rt::SceneRun {
 class DropScene : public rt::Scene {
  public:
   std::string kind() const override { return "drop"; }
-  std::unique_ptr<rt::SceneRun> begin(rt::Run& run, const std::string& out_dir) const override {
+  std::unique_ptr<rt::SceneRun> begin(rt::Run& run) const override {
     return std::make_unique<DropRun>(plane);
   }
   double plane = 0;

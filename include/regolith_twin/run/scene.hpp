@@ -64,9 +64,8 @@ class Scene {
   // bed contacts (a lander's touches by ejecta), m.
   virtual double bed_top() const;
   // Observers and outputs of one run (whose model and state start as
-  // sc.model and start); the caller adds the observers to the run. A front
-  // end that writes no files per run passes an empty out_dir.
-  virtual std::unique_ptr<SceneRun> begin(Run& run, const std::string& out_dir) const = 0;
+  // sc.model and start); the caller adds the observers to the run.
+  virtual std::unique_ptr<SceneRun> begin(Run& run) const = 0;
 };
 
 class SceneKind {

@@ -32,15 +32,15 @@ class LandingKind : public SceneKind {
 
 // --- one run --------------------------------------------------------------------
 
-LandingRun::LandingRun(const LandingScene& scene, const Model& m, const std::string& out_dir)
+LandingRun::LandingRun(const LandingScene& scene, const Model& m)
     : scene_(scene),
       tracker_(scene.lander, scene.run_spec, scene.run_spec.rim + mean_radius(m)),
       ejecta_(scene.run_spec.rim + mean_radius(m), std::max(1, int(std::lround(1e-3 / m.dt)))),  // each millisecond
       zone_(scene.lander, scene.run_spec.active_radius, scene.run_spec.far_ring,
             std::max(1, int(std::lround(1e-3 / m.dt))), &ejecta_) {}
 
-std::unique_ptr<SceneRun> LandingScene::begin(Run& run, const std::string& out_dir) const {
-  return std::make_unique<LandingRun>(*this, run.model(), out_dir);
+std::unique_ptr<SceneRun> LandingScene::begin(Run& run) const {
+  return std::make_unique<LandingRun>(*this, run.model());
 }
 
 LandingOutcome LandingRun::outcome(const RunReport& rep, bool final) const {

@@ -96,7 +96,7 @@ class ScenarioRun : public SceneRun {
 class ScenarioScene : public Scene {
  public:
   std::string kind() const override { return "scenario"; }
-  std::unique_ptr<SceneRun> begin(Run& run, const std::string& out_dir) const override {
+  std::unique_ptr<SceneRun> begin(Run& run) const override {
     return std::make_unique<ScenarioRun>(*this, run);
   }
 };

@@ -20,7 +20,7 @@ class LandingScene : public Scene {
  public:
   std::string kind() const override { return "landing"; }
   double bed_top() const override { return bed_top_; }
-  std::unique_ptr<SceneRun> begin(Run& run, const std::string& out_dir) const override;
+  std::unique_ptr<SceneRun> begin(Run& run) const override;
 
   std::string file;         // landing file it was read from
   LandingSpec spec;         // as given
@@ -36,7 +36,7 @@ class LandingScene : public Scene {
 // One landing run: tracker, active zone, ejecta; the outcome assembled from them.
 class LandingRun : public SceneRun {
  public:
-  LandingRun(const LandingScene& scene, const Model& m, const std::string& out_dir);
+  LandingRun(const LandingScene& scene, const Model& m);
   std::vector<Observer*> observers() override { return {&tracker_, &zone_, &ejecta_}; }
   void write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
                      int threads) const override;
@@ -54,7 +54,6 @@ class LandingRun : public SceneRun {
   LandingTrackerObserver tracker_;
   Ejecta ejecta_;
   ActiveZone zone_;
-  bool finished_ = false;
 };
 
 // The landing kind for the registry.

@@ -27,6 +27,7 @@ void usage(std::FILE* f, const char* tool) {
                "  --set k=v       override a key, e.g. --set contact.steps_per_contact=60 or --set landing.angle_deg=60\n"
                "  --cache DIR     where relaxed beds are kept (default $REGOLITH_CACHE or ~/.cache/regolith_twin)\n"
                "  --snapshot F    also write the final grains as a compact bed snapshot F (float32)\n"
+               "  --snapshot-precision 32|64  positions of the snapshot in float32 (default) or float64 (stiff beds)\n"
                "  --checkpoint F  also write the exact final state (with contact history) to F\n"
                "  --stage-snapshots  also write DIR/<stage>.bed after every stage (restart points)\n"
                "  --quiet         no progress lines\n"
@@ -41,6 +42,7 @@ struct Args {
   std::vector<std::string> overrides;
   int threads = 0;
   bool quiet = false, stage_snapshots = false;
+  SnapshotPrecision precision = SnapshotPrecision::Float32;
 };
 
 // Returns -1 when the arguments are good, else the exit code.
@@ -57,13 +59,20 @@ int parse(int argc, char** argv, const char* tool, Args& a) {
     };
     std::string v;
     if (o == "--out" || o == "--cache" || o == "--snapshot" || o == "--checkpoint" || o == "--set" ||
-        o == "--threads") {
+        o == "--threads" || o == "--snapshot-precision") {
       if (!value(v)) return 2;
       if (o == "--out") a.out = v;
       else if (o == "--cache") a.cache = v;
       else if (o == "--snapshot") a.snapshot = v;
       else if (o == "--checkpoint") a.checkpoint = v;
       else if (o == "--set") a.overrides.push_back(v);
+      else if (o == "--snapshot-precision") {
+        if (v != "32" && v != "64") {
+          std::fprintf(stderr, "%s: --snapshot-precision '%s': expected 32 or 64\n", tool, v.c_str());
+          return 2;
+        }
+        a.precision = v == "64" ? SnapshotPrecision::Float64 : SnapshotPrecision::Float32;
+      }
       else {
         char* end = nullptr;
         a.threads = int(std::strtol(v.c_str(), &end, 10));
@@ -131,7 +140,7 @@ int run_cli(int argc, char** argv, const char* tool) {
       return 3;
     }
     if (!a.snapshot.empty()) {
-      write_snapshot(a.snapshot, m, s);
+      write_snapshot(a.snapshot, m, s, false, a.precision);
       std::printf("snapshot:    %s (%d grains)\n", a.snapshot.c_str(), m.n_grains);
     }
     if (!a.checkpoint.empty()) {

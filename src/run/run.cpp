@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "regolith_twin/core/energy.hpp"
 #include "regolith_twin/core/step.hpp"
 #include "regolith_twin/scene/snapshot.hpp"
 
@@ -109,14 +110,40 @@ void Run::begin_stage() {
     for (int i = 0; i < m_.n_grains; ++i) drop[i] = s_.pos[i].z() > st.trim_above;
     removed = remove_grains(m_, s_, drop, plan_.groups);
   }
+  double injected = 0, kinetic = 0;
   if (st.stiffness_scale > 0 && plan_.scene_kn > 0) {
     // Same steps per contact at the new stiffness. Live springs keep their
-    // extension; the law table is rebuilt for the new k_n.
+    // extension; the law table is rebuilt for the new k_n. Changing k_n on
+    // live contacts changes their elastic energy at fixed positions
+    // (Σ ½ Δk x² and the spring terms that scale with k_n): measured here
+    // against the grains' kinetic energy (docs/model.md §4).
+    const double kn_old = m_.kn;
+    const double el_old = energy(m_, s_).elastic;
     m_.kn = plan_.scene_kn * st.stiffness_scale;
     if (plan_.scene_body_kn > 0) m_.body_kn = plan_.scene_body_kn * st.stiffness_scale;
     m_.dt = plan_.scene_dt / std::sqrt(st.stiffness_scale);
     finalize_model(m_);
     s_.forces_valid = false;
+    if (m_.kn != kn_old) {
+      const Energy e = energy(m_, s_);
+      injected = e.elastic - el_old;
+      kinetic = e.kinetic();
+      const double frac = kinetic > 0 ? injected / kinetic : (injected > 0 ? INFINITY : 0.0);
+      if (opt_.progress_every > 0)
+        std::fprintf(stderr,
+                     "[%s] stage '%s': k_n %.4g -> %.4g N/m, dt %.4g s; elastic energy changed by %.3g J "
+                     "(%.3g %% of the kinetic energy %.3g J)\n",
+                     plan_.name.c_str(), st.name.c_str(), kn_old, m_.kn, m_.dt, injected, 100 * frac, kinetic);
+      if (st.max_injection >= 0 && frac > st.max_injection) {
+        char b[400];
+        std::snprintf(b, sizeof b,
+                      "stage '%s': raising k_n from %.4g to %.4g N/m injects %.3g J, %.3g %% of the grains' kinetic "
+                      "energy %.3g J (limit %.3g %%): relax further at the softer stiffness, or raise it in "
+                      "smaller steps",
+                      st.name.c_str(), kn_old, m_.kn, injected, 100 * frac, kinetic, 100 * st.max_injection);
+        throw BlowUpError(b);
+      }
+    }
   }
   g_from_ = m_.gravity;
   if (st.set_gravity && st.gravity_ramp <= 0) m_.gravity = st.gravity;
@@ -141,7 +168,7 @@ void Run::begin_stage() {
   t_stage_end_ = s_.time + st.duration;
   next_check_ = s_.time + st.check_every;
   next_quench_ = s_.time + st.quench_every;
-  sr_ = StageReport{st.name, 0, "duration", removed};
+  sr_ = StageReport{st.name, 0, "duration", removed, injected, kinetic};
   in_stage_ = true;
 }
 

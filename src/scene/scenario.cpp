@@ -580,7 +580,7 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
       const std::string p = "stages[" + std::to_string(i) + "]";
       rd.only(st[i], p,
               {"name", "duration", "hold", "remove_walls", "until_rms_speed", "until_max_speed", "check_every",
-               "gravity", "gravity_ramp", "trim_above", "stiffness_scale", "quench_every", "minimize", "release_springs"});
+               "gravity", "gravity_ramp", "trim_above", "stiffness_scale", "max_injection", "quench_every", "minimize", "release_springs"});
       Stage s;
       s.name = rd.text(st[i], p, "name", "stage" + std::to_string(i));
       s.duration = rd.number(st[i], p, "duration", 0, 0, 1e9, true);
@@ -613,6 +613,9 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
       s.gravity_ramp = rd.number(st[i], p, "gravity_ramp", 0, 0, s.duration);
       if (s.gravity_ramp > 0 && !s.set_gravity) rd.fail(p + ".gravity_ramp", "needs a 'gravity' to ramp to");
       s.stiffness_scale = rd.number(st[i], p, "stiffness_scale", 0, 0, 1);
+      s.max_injection = rd.number(st[i], p, "max_injection", -1, 0, kInf);
+      if (st[i]["max_injection"] && s.stiffness_scale <= 0)
+        rd.fail(p + ".max_injection", "needs a 'stiffness_scale' (the check is made when k_n changes)");
       s.quench_every = rd.number(st[i], p, "quench_every", 0, 0, kInf);
       s.minimize = rd.boolean(st[i], p, "minimize", false);
       s.release_springs = rd.boolean(st[i], p, "release_springs", false);

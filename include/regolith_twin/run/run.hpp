@@ -50,6 +50,8 @@ struct StageReport {
   double t_end = 0;         // simulated time at the end of the stage, s
   std::string reason;       // "duration", "criteria" or "observer"
   int grains_removed = 0;   // by the stage's trim
+  double stiffness_injection = 0;  // elastic energy added by the stage's change of k_n, J
+  double kinetic_at_switch = 0;    // grains' and bodies' kinetic energy then, J
 };
 
 struct RunReport {

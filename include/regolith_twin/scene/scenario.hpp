@@ -36,6 +36,8 @@ struct Stage {
   Vec3 gravity = Vec3::Zero();        // new gravity, m/s^2
   double gravity_ramp = 0;            // s over which gravity moves geometrically to the new value (0: at once)
   double stiffness_scale = 0;         // > 0: k_n of this stage = scale * the scene's, dt = scene dt / sqrt(scale)
+  double max_injection = -1;          // >= 0: the elastic energy the change of k_n adds must stay below this
+                                      // fraction of the kinetic energy, or the run stops (docs/model.md §4)
                                       //      (softer springs for bed preparation); 0: keep the current values
   double quench_every = 0;            // > 0: every this many seconds, all grain velocities and spins are
                                       //      set to zero (bed preparation: a quasi-static descent)

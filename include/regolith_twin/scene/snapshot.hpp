@@ -1,5 +1,7 @@
-// Compact bed snapshots: grain centres and radii in float32, small enough to
-// ship with the repository (16 bytes a grain), with a checksum. A snapshot
+// Compact bed snapshots: grain centres and radii in float32 (16 bytes a
+// grain) or float64 (32 bytes: for stiff scenes, where float32 rounding of a
+// position, ~1.5e-8 m at 0.2 m, exceeds the equilibrium overlaps; docs/model.md
+// §14), small enough to ship with the repository, with a checksum. A snapshot
 // holds no velocities or contact history: a loaded bed is relaxed again
 // before use (deterministically), and exact states go to checkpoints.
 #pragma once
@@ -12,12 +14,15 @@
 namespace rt {
 
 struct SnapshotGrain {
-  Vec3 pos;       // m (stored as float32)
-  double radius;  // m (stored as float32)
+  Vec3 pos;       // m (stored as float32 or float64)
+  double radius;  // m
 };
 
+enum class SnapshotPrecision { Float32, Float64 };
+
 // Write the free grains (fixed grains are skipped unless include_fixed) atomically.
-void write_snapshot(const std::string& path, const Model& m, const State& s, bool include_fixed = false);
+void write_snapshot(const std::string& path, const Model& m, const State& s, bool include_fixed = false,
+                    SnapshotPrecision precision = SnapshotPrecision::Float32);
 
 // Read a snapshot; throws InputError naming the file when it is missing,
 // truncated, corrupted or of another format.

@@ -58,6 +58,8 @@ class ScenarioRun : public SceneRun {
       JsonObject o;
       o.num("t_end", r.t_end).str("ended_by", r.reason);
       if (r.grains_removed) o.num("grains_removed", r.grains_removed);
+      if (r.stiffness_injection != 0 || r.kinetic_at_switch != 0)
+        o.num("stiffness_injection", r.stiffness_injection).num("kinetic_at_switch", r.kinetic_at_switch);
       stages.obj(r.name, o);
     }
     j.obj("stages", stages);

@@ -12,9 +12,10 @@
 namespace rt {
 namespace {
 
-template <ContactModel M>
-double elastic_energy(const Model& m, const State& s) {
-  double e = 0;
+// Every live grain contact with its elastic energy by spring type, in list
+// order (docs/model.md §15).
+template <ContactModel M, class F>
+void visit_elastic(const Model& m, const State& s, F&& f) {
   const PairList& pl = s.pairs;
   for (int i = 0; i + 1 < static_cast<int>(pl.row_start.size()); ++i)
     for (int k = pl.row_start[i]; k < pl.row_start[i + 1]; ++k) {
@@ -23,8 +24,9 @@ double elastic_energy(const Model& m, const State& s) {
       const double x = rs - (s.pos[j] - s.pos[i]).norm();
       if (x <= 0) continue;
       const double reff = m.grain_radius[i] * m.grain_radius[j] / rs;
-      e += pair_elastic_energy<M>(m.law(m.grain_material[i], m.grain_material[j]), x, reff, pl.spring_t[k],
-                                  pl.spring_r[k], pl.spring_w[k]);
+      f(ElasticContact{ElasticContact::GrainGrain, i, j,
+                       pair_elastic_split<M>(m.law(m.grain_material[i], m.grain_material[j]), x, reff,
+                                             pl.spring_t[k], pl.spring_r[k], pl.spring_w[k])});
     }
   const WallList& wl = s.wall_pairs;
   for (int k = 0; k < wl.size(); ++k) {
@@ -32,8 +34,9 @@ double elastic_energy(const Model& m, const State& s) {
     const Wall& w = m.walls[wl.wall[k]];
     const double x = wall_gap(w, s.pos[i], m.grain_radius[i]).overlap;
     if (x <= 0) continue;
-    e += pair_elastic_energy<M>(m.law(m.grain_material[i], w.law_material), x, m.grain_radius[i], wl.spring_t[k],
-                                wl.spring_r[k], wl.spring_w[k]);
+    f(ElasticContact{ElasticContact::GrainWall, i, wl.wall[k],
+                     pair_elastic_split<M>(m.law(m.grain_material[i], w.law_material), x, m.grain_radius[i],
+                                           wl.spring_t[k], wl.spring_r[k], wl.spring_w[k])});
   }
   const BodyGrainList& bl = s.body_grains;
   std::vector<int> tris;
@@ -58,21 +61,35 @@ double elastic_energy(const Model& m, const State& s) {
             dot = slot[q].normal.dot(sh.rot * h.n);
             best = &slot[q];
           }
-        e += pair_elastic_energy<M>(m.law(m.grain_material[i], bm.material), h.overlap, m.grain_radius[i],
-                                    best->spring_t, best->spring_r, best->spring_w);
+        f(ElasticContact{ElasticContact::GrainBody, i, bl.body[k],
+                         pair_elastic_split<M>(m.law(m.grain_material[i], bm.material), h.overlap,
+                                               m.grain_radius[i], best->spring_t, best->spring_r, best->spring_w)});
       }
       continue;
     }
     const double x =
         shape_gap(bm, bm.shapes[bl.shape[k]], bs.q.conjugate() * (s.pos[i] - bs.pos), m.grain_radius[i]).overlap;
     if (x <= 0) continue;
-    e += pair_elastic_energy<M>(m.law(m.grain_material[i], bm.material), x, m.grain_radius[i], bl.spring_t[k],
-                                bl.spring_r[k], bl.spring_w[k]);
+    f(ElasticContact{ElasticContact::GrainBody, i, bl.body[k],
+                     pair_elastic_split<M>(m.law(m.grain_material[i], bm.material), x, m.grain_radius[i],
+                                           bl.spring_t[k], bl.spring_r[k], bl.spring_w[k])});
   }
-  return e;
+}
+
+template <class F>
+void visit_elastic_any(const Model& m, const State& s, F&& f) {
+  if (!s.lists_valid) return;
+  if (m.contact_model == ContactModel::Linear)
+    visit_elastic<ContactModel::Linear>(m, s, f);
+  else
+    visit_elastic<ContactModel::HertzMindlin>(m, s, f);
 }
 
 }  // namespace
+
+void for_each_elastic_contact(const Model& m, const State& s, const std::function<void(const ElasticContact&)>& f) {
+  visit_elastic_any(m, s, f);
+}
 
 Energy energy(const Model& m, const State& s) {
   Energy e;
@@ -90,9 +107,7 @@ Energy energy(const Model& m, const State& s) {
     e.rotational += body_rot_energy(bm, s.bodies[b]);
     e.potential -= bm.mass * m.gravity.dot(s.bodies[b].pos);
   }
-  if (s.lists_valid)
-    e.elastic = m.contact_model == ContactModel::Linear ? elastic_energy<ContactModel::Linear>(m, s)
-                                                        : elastic_energy<ContactModel::HertzMindlin>(m, s);
+  visit_elastic_any(m, s, [&e](const ElasticContact& c) { e.elastic += c.energy.total(); });
   e.elastic += body_body_elastic_energy(m, s);  // body–body points of the last force pass
   return e;
 }

@@ -163,18 +163,42 @@ inline PairOutput pair_contact(const PairLaw& law, const PairInput& in, PairSpri
   return out;
 }
 
+// Elastic energy stored in one contact by spring type, J (docs/model.md §2,
+// §15): normal ½ k_n x² (Hertz: 2/5 F x), tangential ½ k_t |S|², rolling
+// ½ k_R |δ_R|² with k_R = k_n (βR)², twisting ½ k_T δ_T² with
+// k_T = 2 k_t (βR)²: the stiffnesses pair_contact() uses. A spring type the
+// pair's law has not switched on holds nothing.
+struct ElasticSplit {
+  double normal = 0, tangential = 0, rolling = 0, twisting = 0;
+  double total() const { return normal + tangential + rolling + twisting; }
+  ElasticSplit& operator+=(const ElasticSplit& o) {
+    normal += o.normal;
+    tangential += o.tangential;
+    rolling += o.rolling;
+    twisting += o.twisting;
+    return *this;
+  }
+};
+
+template <ContactModel M>
+inline ElasticSplit pair_elastic_split(const PairLaw& law, double x, double reff, const Vec3& s, const Vec3& roll,
+                                       double twist) {
+  const LawTerms k = law_terms<M>(law, x, reff, 1.0);
+  ElasticSplit e;
+  // Linear: 1/2 k x^2. Hertz: integral of F dx = 2/5 F x.
+  e.normal = (M == ContactModel::Linear) ? 0.5 * k.fn_elastic * x : 0.4 * k.fn_elastic * x;
+  e.tangential = 0.5 * k.kt * s.squaredNorm();
+  const double br2 = law.beta * reff * law.beta * reff;
+  if (law.rolling) e.rolling = 0.5 * k.kn_eff * br2 * roll.squaredNorm();
+  if (law.twisting) e.twisting = 0.5 * 2.0 * k.kt * br2 * twist * twist;
+  return e;
+}
+
 // Elastic energy stored in one contact, J (for energy bookkeeping).
 template <ContactModel M>
 inline double pair_elastic_energy(const PairLaw& law, double x, double reff, const Vec3& s,
                                   const Vec3& roll, double twist) {
-  const LawTerms k = law_terms<M>(law, x, reff, 1.0);
-  // Linear: 1/2 k x^2. Hertz: integral of F dx = 2/5 F x.
-  const double en = (M == ContactModel::Linear) ? 0.5 * k.fn_elastic * x : 0.4 * k.fn_elastic * x;
-  const double br2 = law.beta * reff * law.beta * reff;
-  double e = en + 0.5 * k.kt * s.squaredNorm();
-  if (law.rolling) e += 0.5 * k.kn_eff * br2 * roll.squaredNorm();
-  if (law.twisting) e += 0.5 * 2.0 * k.kt * br2 * twist * twist;
-  return e;
+  return pair_elastic_split<M>(law, x, reff, s, roll, twist).total();
 }
 
 }  // namespace rt

@@ -1,6 +1,9 @@
 // Energy bookkeeping and contact statistics computed on demand from a state.
 #pragma once
 
+#include <functional>
+
+#include "regolith_twin/core/contact_law.hpp"
 #include "regolith_twin/core/state.hpp"
 
 namespace rt {
@@ -15,6 +18,21 @@ struct Energy {
 };
 
 Energy energy(const Model& m, const State& s);
+
+// One live grain contact and its elastic energy by spring type.
+struct ElasticContact {
+  enum Kind { GrainGrain, GrainWall, GrainBody };
+  Kind kind;
+  int i;                // grain (GrainGrain: the lower index)
+  int j;                // partner: grain, wall index or body index
+  ElasticSplit energy;  // J
+};
+
+// Calls f for every live grain–grain, grain–wall and grain–body contact, each
+// once (a mesh contact once per touched feature), in list order: the terms
+// whose sum is Energy::elastic (body–body points aside). Nothing while the
+// lists are not built.
+void for_each_elastic_contact(const Model& m, const State& s, const std::function<void(const ElasticContact&)>& f);
 
 // Kinetic energy of free grains and bodies alone (no pass over the contact
 // lists), J: what a status display needs at a few hertz.

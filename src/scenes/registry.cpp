@@ -2,12 +2,14 @@
 #include "regolith_twin/scenes/registry.hpp"
 
 #include "regolith_twin/scenes/landing/landing_scene.hpp"
+#include "regolith_twin/scenes/sampler/sampler_scene.hpp"
 
 namespace rt {
 
 std::vector<std::shared_ptr<const SceneKind>> builtin_scene_kinds() {
   return {
       landing_kind(),  // MASCOT landing: `landing:` (docs/scenes.md A)
+      sampler_kind(),  // Hayabusa2 sampler shot: `sampler:` (docs/scenes.md B)
   };
 }
 

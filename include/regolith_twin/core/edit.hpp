@@ -26,6 +26,11 @@ int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vec
 // Throws InputError for a radius <= 0 or an unknown material.
 int add_grain(Model& m, State& s, double radius, int material, const Vec3& pos, const Vec3& vel, const Vec3& omega);
 
+// Rotate every grain about the vertical axis through the origin by `angle`
+// (rad), with its velocities, forces and springs (a bed turned for a
+// perturbed repeat of a run).
+void rotate_grains_about_z(const Model& m, State& s, double angle);
+
 // Renumber a per-grain array after remove_grains: v[old_to_new[i]] = v[i]
 // for every kept i (old_to_new[i] <= i, so in place), then shrink.
 template <class T>

@@ -115,23 +115,6 @@ Vec3 landing_gravity(const LandingSpec& sp) {
   return sp.g * (-std::cos(s) * Vec3::UnitZ() - std::sin(s) * heading_dir(sp));
 }
 
-void rotate_bed(const Model& m, State& s, double angle) {
-  const Quat r(Eigen::AngleAxisd(angle, Vec3::UnitZ()));
-  const Mat3 R = r.toRotationMatrix();
-  for (int i = 0; i < m.n_grains; ++i) {
-    s.pos[i] = R * s.pos[i];
-    s.vel[i] = R * s.vel[i];
-    s.omega[i] = R * s.omega[i];
-    s.vel_mid[i] = R * s.vel_mid[i];
-    s.omega_mid[i] = R * s.omega_mid[i];
-    s.force[i] = R * s.force[i];
-    s.torque[i] = R * s.torque[i];
-    s.pos_at_build[i] = R * s.pos_at_build[i];
-  }
-  for (auto* l : {&s.pairs.spring_t, &s.pairs.spring_r, &s.wall_pairs.spring_t, &s.wall_pairs.spring_r})
-    for (Vec3& v : *l) v = R * v;
-}
-
 Perturbation perturbation(const LandingSpec& sp, double mean_radius) {
   Perturbation p;
   if (sp.repeat <= 0) return p;

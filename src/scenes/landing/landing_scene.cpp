@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/observers/surface_map.hpp"
 #include "regolith_twin/run/bed_cache.hpp"
 #include "regolith_twin/run/series.hpp"
@@ -134,7 +135,7 @@ std::unique_ptr<Scene> LandingKind::prepare(const YAML::Node& doc, const std::st
   ls->pert = perturbation(ls->spec, mean_r);
   ls->run_spec = ls->spec;
   if (ls->spec.repeat > 0) {
-    rotate_bed(m, s, ls->pert.angle);
+    rotate_grains_about_z(m, s, ls->pert.angle);
     ls->run_spec.aim += ls->pert.aim_offset;
   }
   s.time = 0;  // landing time counts from the start of the approach

@@ -63,9 +63,6 @@ LandingSpec parse_landing(const YAML::Node& node, const std::string& source);
 // Gravity vector of the spec (magnitude g, tilted for slopes).
 Vec3 landing_gravity(const LandingSpec& spec);
 
-// Rotate the whole bed about the vertical axis through the container centre
-// (positions, velocities, spins and contact springs), for perturbed repeats.
-void rotate_bed(const Model& m, State& s, double angle);
 
 // Perturbation of repeat r: bed rotation angle (rad) and aim offset (m,
 // within one mean grain diameter), drawn from the seed.

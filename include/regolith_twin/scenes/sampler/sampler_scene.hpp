@@ -1,0 +1,73 @@
+// The sampler scene kind (`sampler:` block, docs/scenes.md B): the gravel bed
+// relaxed once at the shot's stiffness and cached (run/bed_cache.hpp), the
+// horn placed with its bottom edge above the bed surface, the projectile
+// added as a grain of its own material above the impact point; each run
+// follows the horn segments and the collected mass, the crater, ejecta,
+// energy partition, impact wave and Z-model flow, and writes series.csv,
+// summary.json and the measurement files.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "regolith_twin/run/scene.hpp"
+#include "regolith_twin/scenes/sampler/horn_geometry.hpp"
+
+namespace rt {
+
+struct SamplerSpec {
+  std::string horn = "horn";       // body name of the horn (fixed)
+  std::string projectile_material = "projectile";
+  double speed = 300;              // m/s (50-300)
+  double tilt_deg = 0;             // from the axis, in the x-z plane (-25..25)
+  double offset = 0;               // of the aim along x, m (-2.5e-3..2.5e-3)
+  double mass = 0.005;             // projectile, kg
+  double radius = 0.004;           // projectile, m
+  double start_gap = 0.005;        // projectile surface above the highest surface grain on the axis, m
+  double horn_clearance = 0.005;   // bottom edge above the bed surface, m
+  double container_radius = 0.15;  // m
+  double duration = 0.02;          // s of simulated time after firing
+  double kn_ref = 5.47e6;          // k_n = kn_ref (v / v_ref)^2, N/m (docs/model.md §4)
+  double dt_ref = 1.5e-6;          // dt = dt_ref (v_ref / v), s
+  double v_ref = 50;               // m/s
+  double dt_factor = 1;            // dt multiplied by this (convergence studies: 0.5, 0.25)
+  double sample_every = 1e-4;      // s between series rows
+  double escape_half_width = 2.0;  // grains beyond this horizontal distance from the axis leave, m
+  double escape_height = 3.0;      // ... or above this height, m
+  int repeat = 0;                  // > 0: perturbed bed (rotated, impact point shifted within a mean radius)
+  unsigned long perturb_seed = 1;
+  std::vector<double> z_times = {45e-6, 1.25e-3, 12.5e-3};  // Z-model fits, s after impact
+  std::vector<double> wave_times = {1.2e-5, 6.2e-5};        // wave profiles, s after impact
+  double energy_window = 2e-4;     // energy partition, s after impact
+  double requirement = 1e-4;       // collected mass required, kg
+};
+
+SamplerSpec parse_sampler(const YAML::Node& n, const std::string& src);
+
+class SamplerScene : public Scene {
+ public:
+  std::string kind() const override { return "sampler"; }
+  double bed_top() const override { return surface_; }
+  std::unique_ptr<SceneRun> begin(Run& run) const override;
+
+  std::string file;
+  SamplerSpec spec;
+  int horn = -1;             // body index
+  int projectile = -1;       // grain index at the start
+  HornGeometry geometry;     // placed horn
+  Vec3 impact = Vec3::Zero();   // aim point on the surface (x, y of the aim; z the surface there)
+  Vec3 direction = -Vec3::UnitZ();  // of the projectile's flight
+  double surface_ = 0;       // highest bed grain centre before the shot (ejecta line), m
+  double surface_top = 0;    // highest bed grain top (z + r), m
+  double rest_rms = 0;       // bed RMS speed at the start, m/s
+  double bed_rotation = 0;   // rad (repeat)
+  Vec3 impact_shift = Vec3::Zero();
+  std::string bed_cache;
+  int bed_grains = 0;
+  double bed_mass = 0, packing = 0, bulk_density = 0, bed_depth = 0;
+};
+
+std::shared_ptr<const SceneKind> sampler_kind();
+
+}  // namespace rt

@@ -30,77 +30,67 @@ class SamplerKind : public SceneKind {
                                  const SceneOptions& opt) const override;
 };
 
-// One shot: the observers of docs/scenes.md B, the impact clock first (the
-// others count their times from it).
-class SamplerRun : public SceneRun {
- public:
-  SamplerRun(const SamplerScene& sc, const Model& m)
-      : SceneRun("sampler"),
-        scene_(sc),
-        clock_(sc.projectile),
-        segments_(sc.geometry, sc.projectile, every_steps(1e-5, m.dt)),
-        escape_(Vec3(sc.impact.x() - sc.spec.escape_half_width, sc.impact.y() - sc.spec.escape_half_width, -1.0),
-                Vec3(sc.impact.x() + sc.spec.escape_half_width, sc.impact.y() + sc.spec.escape_half_width,
-                     sc.spec.escape_height),
-                every_steps(1e-5, m.dt)),
-        ejecta_(&clock_, sc.surface_, sc.impact, sc.spec.container_radius, m.gravity.norm(), every_steps(1e-5, m.dt)),
-        energy_(&clock_, std::max(1, every_steps(sc.spec.energy_window / 100, m.dt)), sc.spec.energy_window),
-        wave_(&clock_, wave_options(sc)),
-        zfit_(&clock_, z_options(sc), sc.rest_rms, sc.spec.z_times),
-        crater_(sc.impact, every_steps(1e-4, m.dt)),
-        packing_(sc.geometry) {}
+WaveOptions wave_options(const SamplerScene& sc) {
+  WaveOptions o;
+  o.impact = sc.impact;
+  o.times = sc.spec.wave_times;
+  o.rest_rms = sc.rest_rms;
+  return o;
+}
 
-  std::vector<Observer*> observers() override {
-    return {&clock_, &segments_, &escape_, &ejecta_, &energy_, &wave_, &zfit_, &crater_, &packing_};
-  }
-  void write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
-                     int threads) const override;
-  void write_files(const std::string& dir, const Model& m, const State& s, const RunReport& rep) const override {
-    ejecta_.write_csv(dir + "/ejecta.csv");
-    energy_.write_csv(dir + "/energy_partition.csv");
-    wave_.write_csv(dir + "/wave.csv");
-    zfit_.write_csv(dir + "/zmodel.csv");
-  }
-  std::vector<std::pair<std::string, std::string>> files() const override {
-    return {{"summary", "summary.json"},          {"time series", "series.csv"}, {"ejecta", "ejecta.csv"},
-            {"energy partition", "energy_partition.csv"}, {"impact wave", "wave.csv"},    {"Z-model fits", "zmodel.csv"}};
-  }
-  std::string result_line(const Model& m, const State& s, const RunReport& rep) const override {
-    char b[400];
-    std::snprintf(b, sizeof b,
-                  "sampler %s: %.0f m/s, collected %.4g mg after %.4g s (requirement %.0f mg %s), crater depth "
-                  "%.3g m, radius %.3g m, %ld ejecta (%.0f s wall)",
-                  scene_.sc.name.c_str(), scene_.spec.speed, segments_.collected_mass() * 1e6, s.time,
-                  scene_.spec.requirement * 1e6, segments_.collected_mass() >= scene_.spec.requirement ? "met" : "not met",
-                  crater_.depth(), crater_.radius(), ejecta_.count(), rep.wall_seconds);
-    return b;
-  }
-  const HornSegments& segments() const { return segments_; }
+ZFitOptions z_options(const SamplerScene& sc) {
+  ZFitOptions o;
+  o.impact = sc.impact;
+  return o;
+}
 
- private:
-  static WaveOptions wave_options(const SamplerScene& sc) {
-    WaveOptions o;
-    o.impact = sc.impact;
-    o.times = sc.spec.wave_times;
-    o.rest_rms = sc.rest_rms;
-    return o;
-  }
-  static ZFitOptions z_options(const SamplerScene& sc) {
-    ZFitOptions o;
-    o.impact = sc.impact;
-    return o;
-  }
-  const SamplerScene& scene_;
-  ImpactClock clock_;
-  HornSegments segments_;
-  Escape escape_;
-  EjectionAngles ejecta_;
-  EnergyPartition energy_;
-  WaveAttenuation wave_;
-  ZModelSampler zfit_;
-  Crater crater_;
-  PackingBelowFilter packing_;
-};
+}  // namespace
+
+SamplerRun::SamplerRun(const SamplerScene& sc, const Model& m)
+    : SceneRun("sampler"),
+      scene_(sc),
+      clock_(sc.projectile),
+      segments_(sc.geometry, sc.projectile, every_steps(1e-5, m.dt), sc.spec.requirement),
+      escape_(Vec3(sc.impact.x() - sc.spec.escape_half_width, sc.impact.y() - sc.spec.escape_half_width, -1.0),
+              Vec3(sc.impact.x() + sc.spec.escape_half_width, sc.impact.y() + sc.spec.escape_half_width,
+                   sc.spec.escape_height),
+              every_steps(1e-5, m.dt)),
+      ejecta_(&clock_, sc.surface_, sc.impact, sc.spec.container_radius, m.gravity.norm(), every_steps(1e-5, m.dt)),
+      energy_(&clock_, every_steps(sc.spec.energy_window / 100, m.dt), sc.spec.energy_window),
+      wave_(&clock_, wave_options(sc)),
+      zfit_(&clock_, z_options(sc), sc.rest_rms, sc.spec.z_times),
+      crater_(sc.impact, sc.projectile, every_steps(1e-4, m.dt)),
+      packing_(sc.geometry) {}
+
+void SamplerRun::write_files(const std::string& dir, const Model& m, const State& s, const RunReport& rep) const {
+  segments_.write_csv(dir + "/collected.csv");
+  ejecta_.write_csv(dir + "/ejecta.csv");
+  energy_.write_csv(dir + "/energy_partition.csv");
+  wave_.write_csv(dir + "/wave.csv");
+  zfit_.write_csv(dir + "/zmodel.csv");
+}
+
+std::vector<std::pair<std::string, std::string>> SamplerRun::files() const {
+  return {{"summary", "summary.json"},
+          {"time series", "series.csv"},
+          {"collected through the top", "collected.csv"},
+          {"ejecta", "ejecta.csv"},
+          {"energy partition", "energy_partition.csv"},
+          {"impact wave", "wave.csv"},
+          {"Z-model fits", "zmodel.csv"}};
+}
+
+std::string SamplerRun::result_line(const Model& m, const State& s, const RunReport& rep) const {
+  char b[400];
+  std::snprintf(b, sizeof b,
+                "sampler %s: %.0f m/s, collected %.4g mg after %.4g s (requirement %.0f mg %s), crater depth "
+                "%.3g m, radius %.3g m, %ld ejecta (%.0f s wall)",
+                scene_.sc.name.c_str(), scene_.spec.speed, segments_.collected_mass() * 1e6, s.time,
+                scene_.spec.requirement * 1e6,
+                segments_.collected_mass() >= scene_.spec.requirement ? "met" : "not met", crater_.depth(),
+                crater_.radius(), ejecta_.count(), rep.wall_seconds);
+  return b;
+}
 
 void SamplerRun::write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
                                int threads) const {
@@ -139,8 +129,6 @@ void SamplerRun::write_summary(const std::string& path, const Model& m, const St
   j.obj("observers", obs);
   j.write(path);
 }
-
-}  // namespace
 
 SamplerSpec parse_sampler(const YAML::Node& n, const std::string& src) {
   SamplerSpec sp;

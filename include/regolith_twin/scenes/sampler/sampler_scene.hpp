@@ -12,7 +12,12 @@
 #include <vector>
 
 #include "regolith_twin/run/scene.hpp"
+#include "regolith_twin/observers/escape.hpp"
+#include "regolith_twin/scenes/sampler/crater.hpp"
 #include "regolith_twin/scenes/sampler/horn_geometry.hpp"
+#include "regolith_twin/scenes/sampler/horn_segments.hpp"
+#include "regolith_twin/scenes/sampler/impact_observers.hpp"
+#include "regolith_twin/scenes/sampler/packing_below_filter.hpp"
 
 namespace rt {
 
@@ -66,6 +71,39 @@ class SamplerScene : public Scene {
   std::string bed_cache;
   int bed_grains = 0;
   double bed_mass = 0, packing = 0, bulk_density = 0, bed_depth = 0;
+};
+
+// One shot: the observers of docs/scenes.md B, the impact clock first (the
+// others count their times from it).
+class SamplerRun : public SceneRun {
+ public:
+  SamplerRun(const SamplerScene& sc, const Model& m);
+  std::vector<Observer*> observers() override {
+    return {&clock_, &segments_, &escape_, &ejecta_, &energy_, &wave_, &zfit_, &crater_, &packing_};
+  }
+  void write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
+                     int threads) const override;
+  void write_files(const std::string& dir, const Model& m, const State& s, const RunReport& rep) const override;
+  std::vector<std::pair<std::string, std::string>> files() const override;
+  std::string result_line(const Model& m, const State& s, const RunReport& rep) const override;
+
+  const SamplerScene& scene() const { return scene_; }
+  const HornSegments& segments() const { return segments_; }
+  const ImpactClock& clock() const { return clock_; }
+  const Crater& crater() const { return crater_; }
+  const EjectionAngles& ejecta() const { return ejecta_; }
+
+ private:
+  const SamplerScene& scene_;
+  ImpactClock clock_;
+  HornSegments segments_;
+  Escape escape_;
+  EjectionAngles ejecta_;
+  EnergyPartition energy_;
+  WaveAttenuation wave_;
+  ZModelSampler zfit_;
+  Crater crater_;
+  PackingBelowFilter packing_;
 };
 
 std::shared_ptr<const SceneKind> sampler_kind();

@@ -522,6 +522,7 @@ void wall_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
         pair_contact<M, Resist>(law, in, PairSprings{wl.spring_t[k], wl.spring_r[k], wl.spring_w[k]}, dt);
     s.force[i] += out.force_i;
     s.torque[i] += out.torque_i;
+    sc.wall_force += out.force_i;
     ++sc.contacts;
     if (s.log_contacts)
       sc.log.push_back({i, -1 - wl.wall[k], in.x, out.fn, out.ft.norm(), out.mr.norm(), std::fabs(out.mt), law.mu_s,
@@ -687,6 +688,7 @@ void force_pass(const Model& m, State& s) {
     sc.contacts = 0;
     sc.max_overlap_ratio = 0;
     sc.max_overlap_grain = -1;
+    sc.wall_force.setZero();
     std::fill(sc.body_force.begin(), sc.body_force.end(), Vec3::Zero());
     std::fill(sc.body_torque.begin(), sc.body_torque.end(), Vec3::Zero());
   }
@@ -782,8 +784,10 @@ void force_pass(const Model& m, State& s) {
   st.contacts = 0;
   st.max_overlap_ratio = 0;
   st.max_overlap_grain = -1;
+  s.wall_force.setZero();
   for (const auto& sc : s.scratch) {
     st.contacts += sc.contacts;
+    s.wall_force += sc.wall_force;
     if (sc.max_overlap_ratio > st.max_overlap_ratio) {
       st.max_overlap_ratio = sc.max_overlap_ratio;
       st.max_overlap_grain = sc.max_overlap_grain;

@@ -1,4 +1,7 @@
 // regolith_verify OUTDIR: analytic collision verification of the engine.
+// regolith_verify --pair STEPS_PER_CONTACT EPS_N [PHASES]: the restitution of
+//   one linear grain-grain and grain-wall collision at that resolution (t_c/dt),
+//   over PHASES entry phases (default 50), as JSON on stdout.
 // Writes CSV tables for scripts/plot_verification.py and prints a summary:
 //   restitution_convergence.csv  linear law, eps_n measured over entry phases vs N
 //   contact_duration.csv         linear law, measured vs analytic duration and max overlap
@@ -32,9 +35,42 @@ double pct(double measured, double ref) { return 100.0 * (measured - ref) / ref;
 
 }  // namespace
 
+// --pair: sweep_phases takes N of dt = pi sqrt(m_p / (2 k_n)) / N, so that
+// t_c / dt = N sqrt(1 + ln^2(eps) / pi^2) for the linear law (docs/model.md §2).
+int pair_at_resolution(int argc, char** argv) {
+  if (argc < 4 || argc > 5) {
+    std::fprintf(stderr, "usage: regolith_verify --pair STEPS_PER_CONTACT EPS_N [PHASES]\n");
+    return 2;
+  }
+  const double spc = std::stod(argv[2]), eps = std::stod(argv[3]);
+  const int phases = argc == 5 ? std::stoi(argv[4]) : 50;
+  if (!(spc > 1) || !(eps > 0 && eps <= 1) || phases < 1) {
+    std::fprintf(stderr, "regolith_verify --pair: need STEPS_PER_CONTACT > 1, 0 < EPS_N <= 1, PHASES >= 1\n");
+    return 2;
+  }
+  const double l = std::log(eps) / M_PI;
+  const double N = spc / std::sqrt(1 + l * l);
+  std::printf("{\"steps_per_contact\": %.4f, \"eps_n\": %.4f, \"phases\": %d", spc, eps, phases);
+  for (rv::PairKind kind : {rv::PairKind::GrainGrain, rv::PairKind::GrainWall}) {
+    const rv::PhaseSweep ps = rv::sweep_phases(kind, eps, N, phases);
+    std::printf(", \"%s\": {\"eps_mean\": %.6f, \"eps_min\": %.6f, \"eps_max\": %.6f, \"mean_error\": %.6f, "
+                "\"worst_abs_error\": %.6f, \"max_overlap_over_xmax\": %.4f, \"all_ended\": %s}",
+                rv::pair_kind_name(kind), ps.eps_mean, ps.eps_min, ps.eps_max, ps.mean_error, ps.worst_abs_error,
+                ps.max_overlap_ratio, ps.all_ended ? "true" : "false");
+  }
+  std::printf("}\n");
+  return 0;
+}
+
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "--pair") try {
+      return pair_at_resolution(argc, argv);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "regolith_verify: %s\n", e.what());
+      return 2;
+    }
   if (argc != 2 || std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help") {
-    std::fprintf(stderr, "usage: regolith_verify OUTDIR\n");
+    std::fprintf(stderr, "usage: regolith_verify OUTDIR | regolith_verify --pair STEPS_PER_CONTACT EPS_N [PHASES]\n");
     return argc == 2 ? 0 : 2;
   }
   try {

@@ -105,6 +105,7 @@ struct ThreadScratch {
   int max_overlap_grain = -1;
   long contacts = 0;
   std::vector<ContactRecord> log;  // filled only while State::log_contacts
+  Vec3 wall_force = Vec3::Zero();  // force of this partition's wall contacts on grains, N
   std::vector<Vec3> body_force;    // grain–body reaction on each body, N (n_bodies)
   std::vector<Vec3> body_torque;   // about each body's centre of mass, N m
   std::vector<int> list_partners;  // list build: partners of this block of rows (capacity kept)
@@ -134,6 +135,8 @@ struct State {
   std::vector<Vec3> omega_mid;  // mid-step angular velocity, rad/s
   std::vector<Vec3> force;      // total force of the last force pass, N
   std::vector<Vec3> torque;     // total torque of the last force pass, N m
+  Vec3 wall_force = Vec3::Zero();  // total force of the walls on the grains in the last force pass, N
+                                   // (partition sums added in partition order: docs/model.md §12)
 
   std::vector<BodyState> bodies;  // rigid bodies (n_bodies)
   // External wrench on each body's centre of mass, world frame (operator

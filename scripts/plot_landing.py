@@ -25,19 +25,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-
-def read_csv(path):
-    """Columns of a CSV file with a header row, as a dict of float arrays (None if absent or empty)."""
-    if not os.path.exists(path):
-        return None
-    with open(path) as f:
-        header = f.readline().strip().split(",")
-        if not header or header == [""]:
-            return None
-        data = np.loadtxt(f, delimiter=",", ndmin=2)
-    if data.size == 0:
-        return None
-    return {k: data[:, i] for i, k in enumerate(header)}
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
+from csv_columns import read_csv  # noqa: E402
 
 
 def load_summary(run):

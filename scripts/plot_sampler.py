@@ -23,23 +23,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-
-def read_csv(path):
-    if not os.path.exists(path):
-        return None
-    with open(path) as f:
-        header = f.readline().strip().split(",")
-        rows = [line.strip().split(",") for line in f if line.strip()]
-    if not rows:
-        return None
-    cols = {}
-    for i, k in enumerate(header):
-        vals = [r[i] for r in rows]
-        try:
-            cols[k] = np.array([float(v) for v in vals])
-        except ValueError:
-            cols[k] = np.array(vals)
-    return cols
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
+from csv_columns import read_csv  # noqa: E402
 
 
 def main():

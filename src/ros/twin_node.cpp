@@ -280,6 +280,8 @@ void TwinNode::on_end() {
     ROS_INFO("twin_node: summary written to %s/summary.json", p_.out_dir.c_str());
   }
   topics_->on_end(*twin_);
+  // The final grains, whatever the particle rate (a recording ends with the run's last state).
+  if (particles_pub_.getNumSubscribers() > 0) publish_particles();
   paused_ = true;  // stays up for inspection; unpause steps on past the run end
   if (p_.shutdown_at_end) ros::requestShutdown();
 }

@@ -36,6 +36,11 @@ void SceneRun::write_summary(const std::string& path, const Model& m, const Stat
   JsonObject j;
   j.str("kind", kind_).str("status", rep.status);
   if (!rep.message.empty()) j.str("message", rep.message);
+  add_run_and_observers(j, m, rep, threads);
+  j.write(path);
+}
+
+void SceneRun::add_run_and_observers(JsonObject& j, const Model& m, const RunReport& rep, int threads) const {
   JsonObject run;
   run.num("grains", m.n_grains).num("steps", double(rep.steps)).num("sim_time", rep.sim_time);
   run.num("wall_seconds", rep.wall_seconds).num("dt", m.dt).num("kn", m.kn);
@@ -44,7 +49,6 @@ void SceneRun::write_summary(const std::string& path, const Model& m, const Stat
   JsonObject obs;
   for (Observer* o : const_cast<SceneRun*>(this)->observers()) o->summary(obs);
   j.obj("observers", obs);
-  j.write(path);
 }
 
 double Scene::bed_top() const { return std::numeric_limits<double>::infinity(); }

@@ -5,30 +5,15 @@ regolith_bag_outcome, and compare it with the node's summary.json."""
 import json
 import os
 import shutil
-import signal
 import subprocess
-import time
 import unittest
-from xmlrpc.client import ServerProxy
 
-import rosgraph
 import roslib.packages
 import rospy
 import rostest
-from std_srvs.srv import Trigger
+from recording import record_run
 
 TOPICS = ["/twin_node/body_states", "/twin_node/landing", "/twin_node/status", "/tf", "/tf_static"]
-
-
-def connected(topic):
-    """The node itself has a live outbound connection on topic (not just a
-    subscriber registered with the master)."""
-    try:
-        uri = rosgraph.Master("/record_replay").lookupNode("/twin_node")
-        code, _, info = ServerProxy(uri).getBusInfo("/record_replay")
-    except Exception:
-        return False
-    return code == 1 and any(c[2] == "o" and c[4] == topic and c[5] for c in info)
 
 
 class RecordReplay(unittest.TestCase):
@@ -38,34 +23,8 @@ class RecordReplay(unittest.TestCase):
         shutil.rmtree(out, ignore_errors=True)
         os.makedirs(out)
         bag = os.path.join(out, "run.bag")
-        rospy.wait_for_service("/twin_node/unpause", timeout=60)
-        # Own process group: the rosbag wrapper and its recorder both get the SIGINT.
-        rec = subprocess.Popen(["rosbag", "record", "--quiet", "-O", bag] + TOPICS, start_new_session=True)
-        try:
-            deadline = time.time() + 30
-            while not all(connected(t) for t in TOPICS[:3]):
-                self.assertLess(time.time(), deadline, "rosbag did not connect")
-                time.sleep(0.1)
-            # The recorder opens its bag on the first message (the paused
-            # node's status): unpause only once it is writing.
-            while not os.path.exists(bag + ".active"):
-                self.assertLess(time.time(), deadline, "rosbag did not open the bag")
-                time.sleep(0.1)
-            time.sleep(1.0)
-            self.assertTrue(rospy.ServiceProxy("/twin_node/unpause", Trigger)().success)
-            summary = os.path.join(out, "summary.json")
-            deadline = time.time() + 60
-            while not os.path.exists(summary):
-                self.assertLess(time.time(), deadline, "the landing did not end")
-                time.sleep(0.2)
-            time.sleep(1.0)  # the last messages reach the recorder
-        finally:
-            os.killpg(rec.pid, signal.SIGINT)
-            rec.wait(timeout=30)
-        deadline = time.time() + 30
-        while not os.path.exists(bag) and time.time() < deadline:  # the recorder closes the bag
-            time.sleep(0.2)
-        self.assertTrue(os.path.exists(bag), "no bag written")
+        summary = os.path.join(out, "summary.json")
+        record_run(self, bag, TOPICS, TOPICS[:3], summary, "/record_replay")
         tool = roslib.packages.find_node("regolith_twin", "regolith_bag_outcome")
         self.assertTrue(tool, "regolith_bag_outcome not built")
         replay = os.path.join(out, "replay.json")

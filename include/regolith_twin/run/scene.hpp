@@ -26,6 +26,8 @@ struct SceneOptions {
   bool quiet = false;      // no progress lines while preparing
 };
 
+class JsonObject;
+
 // One run of a prepared scene: its observers, and its outputs written from them.
 class SceneRun {
  public:
@@ -45,6 +47,11 @@ class SceneRun {
   }
   // One line on the outcome, for the command line and the node's log.
   virtual std::string result_line(const Model& m, const State& s, const RunReport& rep) const = 0;
+
+ protected:
+  // The "run" block (grains, steps, simulated and wall time, dt, k_n,
+  // threads) and the "observers" block (every observer's summary()) of summary.json.
+  void add_run_and_observers(JsonObject& j, const Model& m, const RunReport& rep, int threads) const;
 
  private:
   std::string kind_;

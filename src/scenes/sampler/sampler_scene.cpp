@@ -119,14 +119,7 @@ void SamplerRun::write_summary(const std::string& path, const Model& m, const St
   coll.boolean("requirement_met", segments_.collected_mass() >= sp.requirement);
   coll.num("after", s.time);
   j.obj("collection", coll);
-  JsonObject run;
-  run.num("grains", m.n_grains).num("steps", double(rep.steps)).num("sim_time", rep.sim_time);
-  run.num("wall_seconds", rep.wall_seconds).num("dt", m.dt).num("kn", m.kn);
-  if (threads > 0) run.num("threads", threads);
-  j.obj("run", run);
-  JsonObject obs;
-  for (Observer* o : const_cast<SamplerRun*>(this)->observers()) o->summary(obs);
-  j.obj("observers", obs);
+  add_run_and_observers(j, m, rep, threads);
   j.write(path);
 }
 

@@ -15,8 +15,8 @@
 
 #include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/core/step.hpp"
-#include "regolith_twin/scene/scenario.hpp"
 #include "regolith_twin/scenes/sampler/horn_geometry.hpp"
+#include "horn_alone.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -31,20 +31,7 @@ double uniform(uint64_t& state) {
 }
 
 TEST(HornContainment, GrainsLeaveOnlyThroughTheOpenings) {
-  const std::string yaml = R"(
-name: horn_containment
-gravity: [0, 0, 0]
-materials:
-  regolith: {preset: gravel, density: 2430}
-  horn: {preset: gravel, eps_n: 0.5, eps_t: 0.5, structure: true}
-contact: {model: linear, kn: 5.47e6, dt: 1.5e-6}
-bodies:
-  - {name: horn, urdf: urdf/sampler_horn.urdf, material: horn, fixed: true}
-grains:
-  - {name: first, material: regolith, radius: 0.0025, position: [0, 0, 0.3]}
-stages: [{name: run, duration: 1}]
-)";
-  rt::Scenario sc = rt::parse_scenario_text(yaml, "horn_containment");
+  rt::Scenario sc = rt::test::horn_alone(0.0025, Vec3(0, 0, 0.3));
   rt::Model& m = sc.model;
   rt::State& s = sc.initial;
   const rt::HornGeometry g = rt::HornGeometry::shipped();

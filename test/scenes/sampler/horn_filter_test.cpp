@@ -11,8 +11,8 @@
 #include <string>
 
 #include "regolith_twin/core/step.hpp"
-#include "regolith_twin/scene/scenario.hpp"
 #include "regolith_twin/scenes/sampler/horn_geometry.hpp"
+#include "horn_alone.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -20,25 +20,8 @@ namespace {
 using rt::Vec3;
 constexpr double kPi = 3.14159265358979323846;
 
-// The horn with its bottom aperture centre at the origin, no gravity, one
-// gravel grain of radius r (the probe, placed per start), the contact law and
-// step of a 50 m/s shot (docs/model.md §4).
-rt::Scenario filter_scene(double r) {
-  const std::string yaml = R"(
-name: horn_filter
-gravity: [0, 0, 0]
-materials:
-  regolith: {preset: gravel, density: 2430}
-  horn: {preset: gravel, eps_n: 0.5, eps_t: 0.5, structure: true}
-contact: {model: linear, kn: 5.47e6, dt: 1.5e-6}
-bodies:
-  - {name: horn, urdf: urdf/sampler_horn.urdf, material: horn, fixed: true}
-grains:
-  - {name: probe, material: regolith, radius: )" + std::to_string(r) + R"(, position: [0, 0, 0.5]}
-stages: [{name: run, duration: 1}]
-)";
-  return rt::parse_scenario_text(yaml, "horn_filter");
-}
+// The horn alone with one grain of radius r (the probe, placed per start).
+rt::Scenario filter_scene(double r) { return rt::test::horn_alone(r, Vec3(0, 0, 0.5)); }
 
 struct Shot {
   bool passed = false;   // centre above the plates' top by a radius

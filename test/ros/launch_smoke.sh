@@ -4,13 +4,7 @@
 # cleanly. Run after scripts/run or scripts/test (they build the node):
 #   bash test/ros/launch_smoke.sh
 set -uo pipefail
-ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
-export PATH=/usr/bin:/bin:$PATH
-set +u
-source "${REGOLITH_BUILD:-$ROOT/build}/devel/setup.bash"
-set -u
-port=$((11900 + $$ % 90))
-export ROS_MASTER_URI=http://localhost:$port
+source "$(dirname "${BASH_SOURCE[0]}")/ros_env.sh" 11900
 log=$(mktemp)
 roslaunch -p "$port" regolith_twin mascot_landing.launch threads:=1 out:="$(mktemp -d)" >"$log" 2>&1 &
 launch=$!

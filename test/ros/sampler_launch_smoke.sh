@@ -5,13 +5,7 @@
 # cleanly. Run by ctest (scripts/test), or after a build:
 #   bash test/ros/sampler_launch_smoke.sh
 set -uo pipefail
-ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
-export PATH=/usr/bin:/bin:$PATH
-set +u
-source "${REGOLITH_BUILD:-$ROOT/build}/devel/setup.bash"
-set -u
-port=$((11800 + $$ % 90))
-export ROS_MASTER_URI=http://localhost:$port
+source "$(dirname "${BASH_SOURCE[0]}")/ros_env.sh" 11800
 log=$(mktemp)
 out=$(mktemp -d)
 roslaunch -p "$port" regolith_twin sampler.launch threads:=2 duration:=0.0002 out:="$out" >"$log" 2>&1 &

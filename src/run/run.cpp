@@ -233,6 +233,7 @@ bool Run::advance() {
     s_.vel[held_ids_[h]].setZero();
     s_.omega[held_ids_[h]].setZero();
   }
+  add_grains();
   bool end = false;
   for (Observer* o : obs_) end = o->after_step(m_, s_) || end;
   remove_leaving();
@@ -253,6 +254,15 @@ bool Run::advance() {
   }
   if (opt_.progress_every > 0) progress();
   return true;
+}
+
+void Run::add_grains() {
+  const int n_old = m_.n_grains;
+  for (Observer* o : obs_) o->add_grains(m_, s_);
+  if (m_.n_grains == n_old) return;
+  if (int(held_.size()) == n_old) held_.resize(m_.n_grains, 0);
+  drop_.assign(m_.n_grains, 0);
+  for (Observer* o : obs_) o->grains_added(m_, s_, n_old);
 }
 
 void Run::remove_leaving() {

@@ -25,6 +25,12 @@ class Observer {
   virtual void prepare(Model& m, State& s) {}
   // Before the first step, once the forces of the start state are known.
   virtual void start(const Model& m, const State& s) {}
+  // After every step, before after_step(): grains to add to the run now
+  // (rt::add_grain, core/edit.hpp; a second projectile).
+  virtual void add_grains(Model& m, State& s) {}
+  // Grains [first, m.n_grains) were just added by some observer's
+  // add_grains(): observers that keep per-grain data grow it here.
+  virtual void grains_added(const Model& m, const State& s, int first) {}
   // After every step; true ends the run (a landing that has lifted off and flown).
   virtual bool after_step(Model& m, State& s) { return false; }
   // Grains to take out of the run: set drop[i] = 1 (drop has one zero entry

@@ -101,6 +101,7 @@ class Run {
 
  private:
   bool settle();  // stage transitions up to the next step; false at the end
+  void add_grains();      // grains the observers add, announced to every observer
   void remove_leaving();  // grains the observers take out, renumbered everywhere
   void begin_stage();
   void end_stage(const char* reason);

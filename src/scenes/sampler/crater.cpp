@@ -56,7 +56,7 @@ double sphere_cell_volume(const Vec3& c, double r, double z0, double z1, double 
 Crater::Crater(const Vec3& impact, int projectile, int every, double threshold, double column_radius, double layer,
                double max_depth, double ring_depth, double max_radius)
     : impact_(impact),
-      projectile_(projectile),
+      not_bed_(projectile),
       every_(every),
       threshold_(threshold),
       col_r_(column_radius),
@@ -71,7 +71,7 @@ void Crater::profiles(const Model& m, const State& s, std::vector<double>& col, 
   ring.assign(nr, 0.0);
   const double top = impact_.z(), ring_lo = top - ring_depth_;
   for (int i = 0; i < m.n_grains; ++i) {
-    if (i == projectile_ || m.grain_inv_mass[i] == 0) continue;
+    if (not_bed_(i) || m.grain_inv_mass[i] == 0) continue;
     const Vec3& p = s.pos[i];
     const double r = m.grain_radius[i];
     if (p.z() - r >= top || p.z() + r <= top - max_depth_) continue;
@@ -117,7 +117,7 @@ void Crater::measure(const Model& m, const State& s) {
 }
 
 void Crater::grains_removed(const std::vector<int>& old_to_new) {
-  if (projectile_ >= 0 && projectile_ < int(old_to_new.size())) projectile_ = old_to_new[projectile_];
+  not_bed_.removed(old_to_new);
 }
 
 void Crater::columns(std::vector<std::string>& out) const {

@@ -14,7 +14,7 @@ void HornSegments::count(const Model& m, const State& s) {
   c_.top_count = top_count;
   c_.top_mass = top_mass;
   for (int i = 0; i < m.n_grains; ++i) {
-    if (i == projectile_ || m.grain_inv_mass[i] == 0) continue;
+    if (not_bed_(i) || m.grain_inv_mass[i] == 0) continue;
     const int k = g_.segment_of(s.pos[i]);
     if (k < 0) continue;
     ++c_.count[k];
@@ -28,7 +28,7 @@ bool HornSegments::leaving(const Model& m, const State& s, std::vector<uint8_t>&
   bool any = false;
   const double top = g_.top(), rt = g_.top_radius();
   for (int i = 0; i < m.n_grains; ++i) {
-    if (i == projectile_ || m.grain_inv_mass[i] == 0 || drop[i]) continue;
+    if (not_bed_(i) || m.grain_inv_mass[i] == 0 || drop[i]) continue;
     if (g_.axial(s.pos[i]) <= top || g_.radial(s.pos[i]) >= rt + m.grain_radius[i]) continue;
     drop[i] = 1;
     any = true;
@@ -41,9 +41,7 @@ bool HornSegments::leaving(const Model& m, const State& s, std::vector<uint8_t>&
   return any;
 }
 
-void HornSegments::grains_removed(const std::vector<int>& old_to_new) {
-  if (projectile_ >= 0) projectile_ = projectile_ < int(old_to_new.size()) ? old_to_new[projectile_] : projectile_;
-}
+void HornSegments::grains_removed(const std::vector<int>& old_to_new) { not_bed_.removed(old_to_new); }
 
 void HornSegments::columns(std::vector<std::string>& out) const {
   for (int k = 1; k <= 5; ++k) out.push_back("seg" + std::to_string(k) + "_n");

@@ -134,7 +134,6 @@ void EjectionAngles::start(const Model& m, const State& s) {
 
 bool EjectionAngles::after_step(Model& m, State& s) {
   if (!clock_->hit() || (s.step - clock_->impact_step()) % every_ != 0) return false;
-  if (done_.size() < size_t(m.n_grains)) done_.resize(m.n_grains, 0);  // grains added during the run
   const int p = clock_->projectile();
   const double t = clock_->after(s);
   for (int i = 0; i < m.n_grains; ++i) {

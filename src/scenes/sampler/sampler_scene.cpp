@@ -60,7 +60,34 @@ SamplerRun::SamplerRun(const SamplerScene& sc, const Model& m)
       wave_(&clock_, wave_options(sc)),
       zfit_(&clock_, z_options(sc), sc.rest_rms, sc.spec.z_times),
       crater_(sc.impact, sc.projectile, every_steps(1e-4, m.dt)),
-      packing_(sc.geometry) {}
+      packing_(sc.geometry),
+      second_(sc) {}
+
+SecondShot::SecondShot(const SamplerScene& sc)
+    : enabled_(sc.spec.second_shot),
+      t_(sc.spec.second_delay),
+      radius_(sc.spec.radius),
+      material_(sc.projectile_material),
+      p0_(sc.geometry.origin + sc.geometry.axis * sc.geometry.segment_z[3]),
+      v0_(sc.direction * sc.spec.speed) {}
+
+void SecondShot::add_grains(Model& m, State& s) {
+  if (!enabled_ || t_fired_ >= 0 || s.time < t_ - 0.5 * m.dt) return;
+  grain_ = add_grain(m, s, radius_, material_, p0_, v0_, Vec3::Zero());
+  t_fired_ = s.time;
+}
+
+void SecondShot::grains_removed(const std::vector<int>& old_to_new) {
+  if (grain_ >= 0) grain_ = grain_ < int(old_to_new.size()) ? old_to_new[grain_] : -1;
+}
+
+void SecondShot::summary(JsonObject& out) const {
+  if (!enabled_) return;
+  JsonObject o;
+  o.num("delay", t_).boolean("fired", t_fired_ >= 0).num("t_fired", t_fired_);
+  o.nums("position", {p0_.x(), p0_.y(), p0_.z()}).nums("velocity", {v0_.x(), v0_.y(), v0_.z()});
+  out.obj("second_projectile", o);
+}
 
 void SamplerRun::write_files(const std::string& dir, const Model& m, const State& s, const RunReport& rep) const {
   segments_.write_csv(dir + "/collected.csv");
@@ -132,7 +159,7 @@ SamplerSpec parse_sampler(const YAML::Node& n, const std::string& src) {
           {"horn", "projectile_material", "speed", "tilt_deg", "offset", "mass", "radius", "start_gap",
            "horn_clearance", "container_radius", "duration", "kn_ref", "dt_ref", "v_ref", "dt_factor",
            "sample_every", "escape_half_width", "escape_height", "repeat", "perturb_seed", "z_times", "wave_times",
-           "energy_window", "requirement"});
+           "energy_window", "requirement", "second_shot", "second_delay"});
   sp.horn = rd.text(n, p, "horn", sp.horn);
   sp.projectile_material = rd.text(n, p, "projectile_material", sp.projectile_material);
   sp.speed = rd.number(n, p, "speed", sp.speed, 1, 1e4, true);
@@ -165,6 +192,8 @@ SamplerSpec parse_sampler(const YAML::Node& n, const std::string& src) {
   times("wave_times", sp.wave_times);
   sp.energy_window = rd.number(n, p, "energy_window", sp.energy_window, 0, 1e3);
   sp.requirement = rd.number(n, p, "requirement", sp.requirement, 0, 1e3);
+  sp.second_shot = rd.boolean(n, p, "second_shot", sp.second_shot);
+  sp.second_delay = rd.number(n, p, "second_delay", sp.second_delay, 0, 1e3, true);
   return sp;
 }
 
@@ -277,6 +306,7 @@ std::unique_ptr<Scene> SamplerKind::prepare(const YAML::Node& doc, const std::st
   // path, flying along the axis tilted by tilt_deg in the x-z plane.
   const double pvol = 4.0 / 3.0 * kPi * sp.radius * sp.radius * sp.radius;
   m.materials[proj_mat].density = sp.mass / pvol;
+  ss->projectile_material = proj_mat;
   const double tilt = sp.tilt_deg * kPi / 180;
   ss->direction = Vec3(std::sin(tilt), 0, -std::cos(tilt));
   const double lift = sp.start_gap + sp.radius;

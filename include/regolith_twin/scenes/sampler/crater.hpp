@@ -6,12 +6,13 @@
 // layer (going down) or ring (going out) whose solid fraction is back to at
 // least `threshold` (50 %) of its pre-impact value; layers and rings whose
 // pre-impact fraction is below 0.1 (the rough surface) are passed over. The
-// projectile is not counted. Series columns crater_depth, crater_radius (m).
+// projectile is not counted, nor grains added during the run. Series columns crater_depth, crater_radius (m).
 #pragma once
 
 #include <vector>
 
 #include "regolith_twin/run/observer.hpp"
+#include "regolith_twin/scenes/sampler/not_bed.hpp"
 
 namespace rt {
 
@@ -30,6 +31,7 @@ class Crater : public Observer {
   void start(const Model& m, const State& s) override;
   bool after_step(Model& m, State& s) override;
   void grains_removed(const std::vector<int>& old_to_new) override;
+  void grains_added(const Model& m, const State& s, int first) override { not_bed_.added(first, m.n_grains); }
   void columns(std::vector<std::string>& out) const override;
   void row(const Model& m, const State& s, std::vector<double>& out) const override;
   void finish(Model& m, State& s) override { measure(m, s); }
@@ -47,7 +49,8 @@ class Crater : public Observer {
  private:
   void measure(const Model& m, const State& s);
   Vec3 impact_;
-  int projectile_, every_;
+  NotBed not_bed_;
+  int every_;
   double threshold_, col_r_, layer_, max_depth_, ring_depth_, max_radius_;
   std::vector<double> col0_, ring0_, col_, ring_;
   double depth_ = 0, radius_ = 0;

@@ -13,6 +13,7 @@
 
 #include "regolith_twin/run/observer.hpp"
 #include "regolith_twin/scenes/sampler/horn_geometry.hpp"
+#include "regolith_twin/scenes/sampler/not_bed.hpp"
 
 namespace rt {
 
@@ -30,12 +31,14 @@ class HornSegments : public Observer {
     double t = 0, mass = 0;
     Vec3 pos = Vec3::Zero(), vel = Vec3::Zero();
   };
-  // projectile: grain left out of the counts (-1 none); checked every `every` steps.
+  // projectile: grain left out of the counts (-1 none), as are grains added
+  // during the run (a second projectile); checked every `every` steps.
   HornSegments(const HornGeometry& g, int projectile, int every, double requirement = 1e-4)
-      : g_(g), projectile_(projectile), every_(every), requirement_(requirement) {}
+      : g_(g), not_bed_(projectile), every_(every), requirement_(requirement) {}
   void start(const Model& m, const State& s) override { count(m, s); }
   bool leaving(const Model& m, const State& s, std::vector<uint8_t>& drop) override;
   void grains_removed(const std::vector<int>& old_to_new) override;
+  void grains_added(const Model& m, const State& s, int first) override { not_bed_.added(first, m.n_grains); }
   void columns(std::vector<std::string>& out) const override;
   void row(const Model& m, const State& s, std::vector<double>& out) const override;
   void finish(Model& m, State& s) override { count(m, s); }
@@ -51,7 +54,8 @@ class HornSegments : public Observer {
  private:
   void count(const Model& m, const State& s);
   HornGeometry g_;
-  int projectile_, every_;
+  NotBed not_bed_;
+  int every_;
   double requirement_;
   HornCount c_;
   double t_met_ = -1;

@@ -87,6 +87,8 @@ class EjectionAngles : public Observer {
   void start(const Model& m, const State& s) override;
   bool after_step(Model& m, State& s) override;
   void grains_removed(const std::vector<int>& old_to_new) override;
+  // Grains added during the run (a second projectile) are not bed grains.
+  void grains_added(const Model& m, const State& s, int first) override { done_.resize(m.n_grains, 1); }
   void columns(std::vector<std::string>& out) const override;
   void row(const Model& m, const State& s, std::vector<double>& out) const override;
   void summary(JsonObject& out) const override;

@@ -46,6 +46,8 @@ struct SamplerSpec {
   std::vector<double> wave_times = {1.2e-5, 6.2e-5};        // wave profiles, s after impact
   double energy_window = 2e-4;     // energy partition, s after impact
   double requirement = 1e-4;       // collected mass required, kg
+  bool second_shot = false;        // a second projectile, fired from the bottom of cylinder 4
+  double second_delay = 0.2;       // ... this long after the first, s
 };
 
 SamplerSpec parse_sampler(const YAML::Node& n, const std::string& src);
@@ -60,6 +62,7 @@ class SamplerScene : public Scene {
   SamplerSpec spec;
   int horn = -1;             // body index
   int projectile = -1;       // grain index at the start
+  int projectile_material = -1;  // material index of the projectile(s)
   HornGeometry geometry;     // placed horn
   Vec3 impact = Vec3::Zero();   // aim point on the surface (x, y of the aim; z the surface there)
   Vec3 direction = -Vec3::UnitZ();  // of the projectile's flight
@@ -75,11 +78,32 @@ class SamplerScene : public Scene {
 
 // One shot: the observers of docs/scenes.md B, the impact clock first (the
 // others count their times from it).
+// The optional second projectile (docs/scenes.md B): second_delay after the
+// first, a grain like the first is added on the horn axis at the bottom of
+// cylinder 4, moving along the first one's direction at the shot speed.
+class SecondShot : public Observer {
+ public:
+  explicit SecondShot(const SamplerScene& sc);
+  void add_grains(Model& m, State& s) override;
+  void grains_removed(const std::vector<int>& old_to_new) override;
+  void summary(JsonObject& out) const override;
+  int grain() const { return grain_; }   // current index, -1 before firing or once it left the run
+  double t_fired() const { return t_fired_; }  // s after the first shot, -1 before
+
+ private:
+  bool enabled_;
+  double t_, radius_;
+  int material_;
+  Vec3 p0_, v0_;
+  int grain_ = -1;
+  double t_fired_ = -1;
+};
+
 class SamplerRun : public SceneRun {
  public:
   SamplerRun(const SamplerScene& sc, const Model& m);
   std::vector<Observer*> observers() override {
-    return {&clock_, &segments_, &escape_, &ejecta_, &energy_, &wave_, &zfit_, &crater_, &packing_};
+    return {&clock_, &segments_, &escape_, &ejecta_, &energy_, &wave_, &zfit_, &crater_, &packing_, &second_};
   }
   void write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
                      int threads) const override;
@@ -92,6 +116,7 @@ class SamplerRun : public SceneRun {
   const ImpactClock& clock() const { return clock_; }
   const Crater& crater() const { return crater_; }
   const EjectionAngles& ejecta() const { return ejecta_; }
+  const SecondShot& second() const { return second_; }
 
  private:
   const SamplerScene& scene_;
@@ -104,6 +129,7 @@ class SamplerRun : public SceneRun {
   ZModelSampler zfit_;
   Crater crater_;
   PackingBelowFilter packing_;
+  SecondShot second_;
 };
 
 std::shared_ptr<const SceneKind> sampler_kind();

@@ -59,26 +59,37 @@ TEST(SamplerScene, StiffnessStepAndPlacement) {
 }
 
 struct ShotResult {
+  rt::Model m;
   rt::State s;
   rt::HornCount count;
   bool hit = false;
+  int second = -1;         // the second projectile's grain, -1 if none
+  double t_second = -1;    // when it was fired, s
 };
 
-ShotResult shoot(int threads, const std::string& checkpoint = "") {
-  omp_set_num_threads(threads);
-  auto sc = load();
-  rt::Model m = sc->sc.model;
-  rt::State s = sc->start;
+// One shot of a loaded scene to its end, with the scene's observers.
+ShotResult run_shot(std::unique_ptr<rt::SamplerScene> sc) {
+  ShotResult out{sc->sc.model, sc->start};
   rt::RunOptions ro;
   ro.progress_every = 0;
-  rt::Run run(m, s, sc->plan, ro);
+  rt::Run run(out.m, out.s, sc->plan, ro);
   auto sr = sc->begin(run);
   for (rt::Observer* o : sr->observers()) run.add_observer(o);
   const rt::RunReport rep = run.run();
   EXPECT_EQ(rep.status, "ok") << rep.message;
   auto& r = static_cast<rt::SamplerRun&>(*sr);
-  if (!checkpoint.empty()) rt::save_checkpoint(checkpoint, m, s);
-  return {s, r.segments().now(), r.clock().hit()};
+  out.count = r.segments().now();
+  out.hit = r.clock().hit();
+  out.second = r.second().grain();
+  out.t_second = r.second().t_fired();
+  return out;
+}
+
+ShotResult shoot(int threads, const std::string& checkpoint = "") {
+  omp_set_num_threads(threads);
+  ShotResult r = run_shot(load());
+  if (!checkpoint.empty()) rt::save_checkpoint(checkpoint, r.m, r.s);
+  return r;
 }
 
 TEST(SamplerScene, ShortShotRecountAndThreads) {
@@ -110,48 +121,28 @@ TEST(SamplerScene, ShortShotRecountAndThreads) {
 // are those of the same shot without it.
 TEST(SamplerScene, SecondProjectile) {
   omp_set_num_threads(1);
-  const std::vector<std::string> set = {"sampler.duration=0.002"};
-  auto run_shot = [](std::unique_ptr<rt::SamplerScene> sc, rt::State& out, rt::HornCount& count, int& grain,
-                     double& t_fired) {
-    rt::Model m = sc->sc.model;
-    rt::State s = sc->start;
-    rt::RunOptions ro;
-    ro.progress_every = 0;
-    rt::Run run(m, s, sc->plan, ro);
-    auto sr = sc->begin(run);
-    for (rt::Observer* o : sr->observers()) run.add_observer(o);
-    EXPECT_EQ(run.run().status, "ok");
-    auto& r = static_cast<rt::SamplerRun&>(*sr);
-    out = s;
-    count = r.segments().now();
-    grain = r.second().grain();
-    t_fired = r.second().t_fired();
-    return m;
-  };
-  rt::State s1, s2;
-  rt::HornCount c1, c2;
-  int g1 = -1, g2 = -1;
-  double t1 = -1, t2 = -1;
-  auto one = load(set);
+  auto one = load({"sampler.duration=0.002"});
   const int n0 = one->sc.model.n_grains;
-  run_shot(std::move(one), s1, c1, g1, t1);
-  EXPECT_EQ(g1, -1);
+  const ShotResult a = run_shot(std::move(one));
+  EXPECT_EQ(a.second, -1);
   auto two = load({"sampler.duration=0.002", "sampler.second_shot=true", "sampler.second_delay=0.001"});
   const rt::HornGeometry g = two->geometry;
   const Vec3 dir = two->direction;
-  const rt::Model m2 = run_shot(std::move(two), s2, c2, g2, t2);
+  const ShotResult b = run_shot(std::move(two));
+  const rt::Model& m2 = b.m;
+  const int g2 = b.second;
   ASSERT_EQ(m2.n_grains, n0 + 1);
   ASSERT_EQ(g2, n0);
-  EXPECT_LE(std::abs(t2 - 0.001), 0.5 * m2.dt + 1e-12) << "fired at the step end nearest the delay";
+  EXPECT_LE(std::abs(b.t_second - 0.001), 0.5 * m2.dt + 1e-12) << "fired at the step end nearest the delay";
   EXPECT_DOUBLE_EQ(m2.grain_radius[g2], 0.004);
   EXPECT_NEAR(1 / m2.grain_inv_mass[g2], 0.005, 1e-12);
   // Free flight from the bottom of cylinder 4 (no contact on the way down).
   const Vec3 p0 = g.origin + g.axis * g.segment_z[3], v0 = dir * 50.0;
-  const double T = s2.time - t2;
+  const double T = b.s.time - b.t_second;
   const Vec3 expect = p0 + v0 * T + 0.5 * m2.gravity * T * T;
-  EXPECT_LT((s2.pos[g2] - expect).norm(), 1e-9);
-  EXPECT_LT((s2.vel[g2] - (v0 + m2.gravity * T)).norm(), 1e-9);
-  for (int k = 0; k < 5; ++k) EXPECT_EQ(c2.count[k], c1.count[k]) << "cylinder " << k + 1;
+  EXPECT_LT((b.s.pos[g2] - expect).norm(), 1e-9);
+  EXPECT_LT((b.s.vel[g2] - (v0 + m2.gravity * T)).norm(), 1e-9);
+  for (int k = 0; k < 5; ++k) EXPECT_EQ(b.count.count[k], a.count.count[k]) << "cylinder " << k + 1;
 }
 
 TEST(SamplerScene, BadInputIsRefused) {

@@ -275,9 +275,14 @@ void TwinNode::on_end() {
 #ifdef _OPENMP
     threads = omp_get_max_threads();
 #endif
-    rt::make_dirs(p_.out_dir);
-    twin_->write_summary(p_.out_dir + "/summary.json", failed_ ? "blow_up" : "ok", failure_, threads);
-    ROS_INFO("twin_node: summary written to %s/summary.json", p_.out_dir.c_str());
+    try {
+      rt::make_dirs(p_.out_dir);
+      twin_->write_files(p_.out_dir);
+      twin_->write_summary(p_.out_dir + "/summary.json", failed_ ? "blow_up" : "ok", failure_, threads);
+      ROS_INFO("twin_node: summary and the scene's files written to %s", p_.out_dir.c_str());
+    } catch (const std::exception& e) {
+      ROS_ERROR("twin_node: cannot write the run's files to %s: %s", p_.out_dir.c_str(), e.what());
+    }
   }
   topics_->on_end(*twin_);
   // The final grains, whatever the particle rate (a recording ends with the run's last state).

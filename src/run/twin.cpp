@@ -81,6 +81,8 @@ void Twin::write_summary(const std::string& path, const std::string& status, con
   scene_run_->write_summary(path, model_, state_, r, threads);
 }
 
+void Twin::write_files(const std::string& dir) const { scene_run_->write_files(dir, model_, state_, report()); }
+
 int Twin::body_index(const std::string& name) const {
   for (size_t b = 0; b < model_.bodies.size(); ++b)
     if (model_.bodies[b].name == name) return int(b);

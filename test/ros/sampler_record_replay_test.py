@@ -106,6 +106,10 @@ class SamplerRecordReplay(unittest.TestCase):
         self.assertAlmostEqual(collected, horn["collected_mass"], delta=tol)
         self.assertAlmostEqual(collected, last_msg.mass, delta=tol)
         self.assertEqual(last_msg.requirement_met, horn["requirement_met"])
+        # The node writes the scene's files too: collected.csv lists the grains that left through the top.
+        with open(os.path.join(out, "collected.csv")) as f:
+            rows = [line for line in f.read().splitlines()[1:] if line.strip()]
+        self.assertEqual(len(rows), horn["collected_top_grains"])
 
 
 if __name__ == "__main__":

@@ -51,6 +51,10 @@ class Twin {
   std::string result_line() const;
   void write_summary(const std::string& path, const std::string& status, const std::string& message,
                      int threads) const;
+  // The scene kind's own files of the run so far into dir (the sampler's
+  // collected.csv, ejecta.csv, ...; the landing's surface.csv), as the
+  // command-line tools write them next to summary.json.
+  void write_files(const std::string& dir) const;
 
   // Contacts of body b, with the bed top of this scene.
   BodyContacts contacts(int b) const;

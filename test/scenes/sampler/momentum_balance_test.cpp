@@ -49,7 +49,7 @@ TEST(MomentumBalance, ExternalImpulseThroughTheImpact) {
   s.forces_valid = true;
   const Vec3 p0 = momentum(m, s);
   Vec3 imp_walls = h * walls(), imp_horn = h * horn(), imp_gravity = Vec3::Zero();
-  double bound = scale(), horn_peak = horn().norm(), max_overlap = 0;
+  double bound = scale();
   const long steps = std::lround(0.005 / m.dt);  // the projectile hits about 0.1 ms in
   for (long k = 0; k < steps; ++k) {
     rt::step(m, s);
@@ -58,20 +58,17 @@ TEST(MomentumBalance, ExternalImpulseThroughTheImpact) {
     imp_horn += w * horn();
     imp_gravity += m.dt * mass * m.gravity;
     bound += scale();
-    horn_peak = std::max(horn_peak, horn().norm());
-    max_overlap = std::max(max_overlap, s.stats.max_overlap_ratio);
   }
   const Vec3 dp = momentum(m, s) - p0;
   const double tol = 4 * eps * bound;
   const double residual = (dp - imp_walls - imp_horn - imp_gravity).norm();
   EXPECT_LT(residual, tol);
   EXPECT_GT(dp.norm(), 0.1) << "the projectile (0.25 kg m/s) should have hit the bed";
-  // Each external term matters far beyond the tolerance.
+  // Each external term present matters far beyond the tolerance. No grain
+  // reaches the horn in these 5 ms (its impulse is zero here): the horn's
+  // term is checked in horn_containment_test.
   EXPECT_GT((dp - imp_horn - imp_gravity).norm(), 1e3 * tol) << "walls";
   EXPECT_GT((dp - imp_walls - imp_horn).norm(), 1e3 * tol) << "gravity";
-  if (horn_peak > 0) {
-    EXPECT_GT((dp - imp_walls - imp_gravity).norm(), 1e3 * tol) << "horn";
-  }
   RecordProperty("residual", rt::test::figure(residual));
   RecordProperty("tolerance", rt::test::figure(tol));
   RecordProperty("wall_impulse", rt::test::figure(imp_walls.norm()));

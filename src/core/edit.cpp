@@ -170,6 +170,12 @@ int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vec
   for (std::vector<Vec3>* v : {&s.pos, &s.vel, &s.omega, &s.vel_mid, &s.omega_mid, &s.force, &s.torque, &s.pos_at_build})
     compact(*v, map, kept);
   size_scratch(s, kept);
+  if (s.sleep.initialized) {  // sleep flags and force references follow their grains (model.md §16)
+    compact(s.sleep.asleep, map, kept);
+    compact(s.sleep.f_ref, map, kept);
+    compact(s.sleep.f_last, map, kept);
+    s.sleep.cell_scratch.assign(kept, -1);
+  }
   if (s.stats.max_overlap_grain >= 0 && s.stats.max_overlap_grain < n)
     s.stats.max_overlap_grain = map[s.stats.max_overlap_grain];
 
@@ -214,6 +220,12 @@ int add_grain(Model& m, State& s, double radius, int material, const Vec3& pos, 
   s.torque.push_back(Vec3::Zero());
   s.pos_at_build.push_back(pos);  // not yet in any list: counts as moved by nothing
   size_scratch(s, n + 1);
+  if (s.sleep.initialized) {  // a new grain is awake
+    s.sleep.asleep.push_back(0);
+    s.sleep.f_ref.push_back(Vec3::Zero());
+    s.sleep.f_last.push_back(Vec3::Zero());
+    s.sleep.cell_scratch.push_back(-1);
+  }
   // An empty row for the new grain keeps the pair list valid.
   if (s.lists_valid && int(s.pairs.row_start.size()) == n + 1) {
     s.pairs.row_start.push_back(s.pairs.row_start.back());
@@ -240,6 +252,11 @@ void rotate_grains_about_z(const Model& m, State& s, double angle) {
   }
   for (auto* l : {&s.pairs.spring_t, &s.pairs.spring_r, &s.wall_pairs.spring_t, &s.wall_pairs.spring_r})
     for (Vec3& v : *l) v = R * v;
+  // The sleep cells do not turn with the bed: sleeping starts again, every grain awake.
+  if (s.sleep.initialized) {
+    s.sleep = SleepState{};
+    s.forces_valid = false;
+  }
 }
 
 }  // namespace rt

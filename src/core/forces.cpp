@@ -36,13 +36,16 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec
   long contacts = 0;
   double max_ratio = sc.max_overlap_ratio;
   int max_grain = sc.max_overlap_grain;
+  const uint8_t* asleep = sleep_active(m, s) ? s.sleep.asleep.data() : nullptr;
   for (int i = rb; i < re; ++i) {
     const Vec3 xi = pos[i], vi = vel[i], wi = omega[i], vi_mid = vel_mid[i], wi_mid = omega_mid[i];
     const double ri = radius[i];
     const PairLaw* laws = &m.pair_law[material[i] * nm];
     Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
+    const bool idle_i = asleep && (asleep[i] || m.grain_inv_mass[i] == 0);
     for (int k = row[i]; k < row[i + 1]; ++k) {
       const int j = partner[k];
+      if (idle_i && (asleep[j] || m.grain_inv_mass[j] == 0)) continue;  // both asleep: not evaluated (model.md §16)
       const Vec3 d = pos[j] - xi;
       const double rj = radius[j];
       const double rs = ri + rj;
@@ -389,7 +392,7 @@ void flush_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_law,
 }
 
 template <ContactModel M, bool Uniform, bool Resist>
-void pair_rows_batched(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec3* __restrict T,
+void pair_rows_batched(const Model& m, State& s, int gb, int ge, Vec3* __restrict F, Vec3* __restrict T,
                        ThreadScratch& sc) {
   PairList& pl = s.pairs;
   const PairLaw& uniform_law = m.pair_law[Uniform ? m.single_grain_material * (m.n_materials() + 1) : 0];
@@ -399,7 +402,6 @@ void pair_rows_batched(const Model& m, State& s, int rb, int re, Vec3* __restric
   const double* __restrict radius = m.grain_radius.data();
   const int* __restrict material = m.grain_material.data();
   const int* __restrict partner = pl.partner.data();
-  const int* __restrict row = pl.row_start.data();
   const int* __restrict owner = pl.owner.data();
   const double* __restrict sqrt_mstar = pl.sqrt_mstar.data();
   uint8_t* __restrict touching = pl.touching.data();
@@ -418,7 +420,8 @@ void pair_rows_batched(const Model& m, State& s, int rb, int re, Vec3* __restric
   // without a branch (the record is written at nb either way, nb advances
   // only when touching), so the entries that do not touch (1 in 4 in a
   // settled bed) cost no mispredicted jump, nor do the ends of rows.
-  for (int k0 = row[rb], kend_rows = row[re]; k0 < kend_rows;) {
+  for (int seg = gb; seg < ge; ++seg)
+  for (int k0 = s.seg_begin[seg], kend_rows = s.seg_end[seg]; k0 < kend_rows;) {
     if (nb == kBlock) {
       flush_block<M, Uniform, Resist>(b, nb, dt, uniform_law, g, pl, F, T, r);
       nb = 0;
@@ -494,8 +497,10 @@ template <ContactModel M, bool Resist>
 void wall_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
   WallList& wl = s.wall_pairs;
   const double dt = m.dt;
+  const uint8_t* asleep = sleep_active(m, s) ? s.sleep.asleep.data() : nullptr;
   for (int k = kb; k < ke; ++k) {
     const int i = wl.grain[k];
+    if (asleep && asleep[i]) continue;  // a sleeping grain's wall contacts do not change (model.md §16)
     const Wall& w = m.walls[wl.wall[k]];
     const double ri = m.grain_radius[i];
     const WallGap gap = wall_gap(w, s.pos[i], ri);
@@ -714,11 +719,11 @@ void force_pass(const Model& m, State& s) {
         std::fill(F + sc.touched_lo, F + sc.touched_hi, Vec3::Zero());
         std::fill(T + sc.touched_lo, T + sc.touched_hi, Vec3::Zero());
       }
-      const int rb = s.thread_row_begin[p], re = s.thread_row_begin[p + 1];
+      const int gb = s.thread_seg_begin[p], ge = s.thread_seg_begin[p + 1];
       if (batched && m.single_grain_material >= 0)
-        pair_rows_batched<M, true, Resist>(m, s, rb, re, F, T, sc);
+        pair_rows_batched<M, true, Resist>(m, s, gb, ge, F, T, sc);
       else if (batched)
-        pair_rows_batched<M, false, Resist>(m, s, rb, re, F, T, sc);
+        pair_rows_batched<M, false, Resist>(m, s, gb, ge, F, T, sc);
       else
         pair_rows<M, Resist>(m, s, s.thread_row_begin[p], s.thread_row_begin[p + 1], F, T, sc);
     }  // (implied barrier)
@@ -798,7 +803,91 @@ void force_pass(const Model& m, State& s) {
   st.contacts -= wall_contacts + body_contacts;
 }
 
+// Contacts of woken grains that the last pass did not evaluate (both grains
+// at rest: springs held, as copies), added to the woken grains' forces.
+template <ContactModel M, bool Resist>
+void woken_contacts(const Model& m, State& s, const std::vector<uint8_t>& woken) {
+  const PairList& pl = s.pairs;
+  const double dt = m.dt;
+  const int nm = m.n_materials();
+  // Idle before the wake: asleep then (still asleep, or woken now) or glued.
+  const auto idle_before = [&](int i) { return s.sleep.asleep[i] || woken[i] || m.grain_inv_mass[i] == 0; };
+  for (int k = 0; k < pl.size(); ++k) {
+    const int i = pl.owner[k], j = pl.partner[k];
+    if (!(woken[i] || woken[j]) || !idle_before(i) || !idle_before(j)) continue;
+    const Vec3 d = s.pos[j] - s.pos[i];
+    const double ri = m.grain_radius[i], rj = m.grain_radius[j], rs = ri + rj;
+    const double dist2 = d.squaredNorm();
+    if (dist2 >= rs * rs) continue;
+    const double inv_dist = 1.0 / std::sqrt(dist2);
+    PairInput in;
+    in.n = d * inv_dist;
+    in.x = rs - dist2 * inv_dist;
+    in.li = ri - 0.5 * in.x;
+    in.lj = rj - 0.5 * in.x;
+    in.reff = ri * rj / rs;
+    in.sqrt_mstar = pl.sqrt_mstar[k];
+    in.vrel = s.vel[j] - s.vel[i];
+    in.wi = s.omega[i];
+    in.wj = s.omega[j];
+    in.vrel_mid = s.vel_mid[j] - s.vel_mid[i];
+    in.wi_mid = s.omega_mid[i];
+    in.wj_mid = s.omega_mid[j];
+    Vec3 st = pl.spring_t[k], sr = pl.spring_r[k];
+    double sw = pl.spring_w[k];
+    const PairLaw& law = m.pair_law[m.grain_material[i] * nm + m.grain_material[j]];
+    const PairOutput out = pair_contact<M, Resist>(law, in, PairSprings{st, sr, sw}, dt);
+    if (woken[i]) {
+      s.force[i] += out.force_i;
+      s.torque[i] += out.torque_i;
+    }
+    if (woken[j]) {
+      s.force[j] -= out.force_i;
+      s.torque[j] += out.torque_j;
+    }
+  }
+  const WallList& wl = s.wall_pairs;
+  for (int k = 0; k < wl.size(); ++k) {
+    const int i = wl.grain[k];
+    if (!woken[i]) continue;
+    const Wall& w = m.walls[wl.wall[k]];
+    const double ri = m.grain_radius[i];
+    const WallGap gap = wall_gap(w, s.pos[i], ri);
+    if (gap.overlap <= 0) continue;
+    PairInput in;
+    in.n = gap.n;
+    in.x = gap.overlap;
+    in.li = ri - 0.5 * in.x;
+    in.lj = 0;
+    in.reff = ri;
+    in.sqrt_mstar = std::sqrt(m.grain_mass[i]);
+    in.vrel = -s.vel[i];
+    in.wi = s.omega[i];
+    in.wj.setZero();
+    in.vrel_mid = -s.vel_mid[i];
+    in.wi_mid = s.omega_mid[i];
+    in.wj_mid.setZero();
+    Vec3 st = wl.spring_t[k], sr = wl.spring_r[k];
+    double sw = wl.spring_w[k];
+    const PairLaw& law = m.law(m.grain_material[i], w.law_material);
+    const PairOutput out = pair_contact<M, Resist>(law, in, PairSprings{st, sr, sw}, dt);
+    s.force[i] += out.force_i;
+    s.torque[i] += out.torque_i;
+  }
+}
+
 }  // namespace
+
+void add_woken_contacts(const Model& m, State& s, const std::vector<uint8_t>& woken) {
+  const bool resist = m.any_resistance;
+  if (m.contact_model == ContactModel::Linear) {
+    resist ? woken_contacts<ContactModel::Linear, true>(m, s, woken)
+           : woken_contacts<ContactModel::Linear, false>(m, s, woken);
+  } else {
+    resist ? woken_contacts<ContactModel::HertzMindlin, true>(m, s, woken)
+           : woken_contacts<ContactModel::HertzMindlin, false>(m, s, woken);
+  }
+}
 
 void compute_forces(const Model& m, State& s) {
   const bool resist = m.any_resistance;

@@ -27,8 +27,14 @@ void kick_drift(const Model& m, State& s, double h, double dt) {
   Vec3* __restrict omega_mid = s.omega_mid.data();
   bool finite = true;
   double max_d2 = s.stats.max_disp2;
+  // With sleeping, only the awake grains (ascending ids); sleeping grains
+  // keep zero velocities and do not move (model.md §16).
+  const bool sleeping = sleep_active(m, s);
+  const int* __restrict awake = s.sleep.awake.data();
+  const int count = sleeping ? int(s.sleep.awake.size()) : n;
 #pragma omp parallel for schedule(static) reduction(&& : finite) reduction(max : max_d2) if (n >= m.parallel_min_grains)
-  for (int i = 0; i < n; ++i) {
+  for (int q = 0; q < count; ++q) {
+    const int i = sleeping ? awake[q] : q;
     const double im = inv_mass[i];
     if (im == 0) {  // glued grain
       vel_mid[i] = vel[i];
@@ -64,8 +70,12 @@ void finish_kick(const Model& m, State& s, double h) {
   Vec3* __restrict vel = s.vel.data();
   Vec3* __restrict omega = s.omega.data();
   bool finite = true;
+  const bool sleeping = sleep_active(m, s);
+  const int* __restrict awake = s.sleep.awake.data();
+  const int count = sleeping ? int(s.sleep.awake.size()) : n;
 #pragma omp parallel for schedule(static) reduction(&& : finite) if (n >= m.parallel_min_grains)
-  for (int i = 0; i < n; ++i) {
+  for (int q = 0; q < count; ++q) {
+    const int i = sleeping ? awake[q] : q;
     const double im = inv_mass[i];
     if (im == 0) continue;
     const Vec3 v = vel_mid[i] + h * (force[i] * im + g);

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "regolith_twin/core/history.hpp"
+#include "regolith_twin/core/sleep.hpp"
 #include "regolith_twin/core/walls.hpp"
 
 namespace rt {
@@ -402,6 +403,10 @@ void build_body_list(const Model& m, State& s) {
   // checkpoint restore or a moved bed): bin the current positions again.
   const Grid g = bin_grains(m, s);
   build_body_grains(m, s, g);
+  if (sleep_active(m, s)) {
+    sleep_segments(m, s);  // the watch list follows the grain–body entries
+    s.sleep.ref_pending = true;
+  }
 }
 
 // Split rows into partitions of about equal entry counts; record the grain
@@ -439,6 +444,19 @@ void partition_work(const Model& m, State& s) {
   // Wall entries: those of grains [n q/P, n (q+1)/P) form partition q (the
   // force pass merges that block of grains and adds its wall contacts in one go).
   const WallList& wl = s.wall_pairs;
+  if (sleep_active(m, s)) {
+    sleep_segments(m, s);  // the entries with an awake grain, split by count (model.md §16)
+  } else {
+    s.seg_begin.resize(P);
+    s.seg_end.resize(P);
+    s.thread_seg_begin.resize(P + 1);
+    for (int p = 0; p < P; ++p) {
+      s.seg_begin[p] = pl.row_start[s.thread_row_begin[p]];
+      s.seg_end[p] = pl.row_start[s.thread_row_begin[p + 1]];
+      s.thread_seg_begin[p] = p;
+    }
+    s.thread_seg_begin[P] = P;
+  }
   s.thread_wall_begin.resize(P + 1);
   for (int q = 0; q <= P; ++q)
     s.thread_wall_begin[q] =
@@ -459,6 +477,10 @@ void build_neighbour_lists(const Model& m, State& s) {
   s.pos_at_build = s.pos;
   s.stats.max_disp2 = 0;
   build_body_grains(m, s, g);
+  if (sleep_active(m, s)) {
+    sleep_segments(m, s);  // again: the watch list includes the new grain–body entries
+    s.sleep.ref_pending = true;  // the evaluated contacts of sleeping grains changed
+  }
   s.lists_valid = true;
   s.rebuild_requested = false;
   ++s.rebuilds;

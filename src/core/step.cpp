@@ -7,6 +7,7 @@
 #include "regolith_twin/core/forces.hpp"
 #include "regolith_twin/core/integrate.hpp"
 #include "regolith_twin/core/neighbours.hpp"
+#include "regolith_twin/core/sleep.hpp"
 
 namespace rt {
 
@@ -64,6 +65,7 @@ void step(const Model& m, State& s) {
   s.time += m.dt;
   ++s.step;
   check_guards(m, s);                                              // guards
+  update_sleep(m, s);                                              // sleep: wake and put quiet cells to sleep
 }
 
 void check_guards(const Model& m, const State& s) {

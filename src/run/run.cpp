@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "regolith_twin/core/energy.hpp"
+#include "regolith_twin/core/sleep.hpp"
 #include "regolith_twin/core/step.hpp"
 #include "regolith_twin/scene/snapshot.hpp"
 
@@ -77,6 +78,7 @@ bool Run::settle() {
     t0_ = last_progress_ = Clock::now();
     t_start_ = s_.time;
     step0_ = s_.step;
+    awake0_ = s_.sleep.awake_grain_steps;
     next_sample_ = s_.time;
     for (Observer* o : obs_) o->prepare(m_, s_);
     if (!s_.forces_valid) prime(m_, s_);
@@ -329,6 +331,11 @@ void Run::progress() {
   else
     std::snprintf(head, sizeof head, "[%s] %s  t = %.4g s", plan_.name.c_str(), plan_.stages[k_].name.c_str(),
                   s_.time);
+  if (sleep_active(m_, s_)) {
+    char b[64];
+    std::snprintf(b, sizeof b, "  awake %zu", s_.sleep.awake.size());
+    text += b;
+  }
   std::fprintf(stderr, "%s%s  %.3g steps/s  %.3g grain-steps/s  %s\n", head, text.c_str(), steps_s,
                steps_s * m_.n_grains, eta.c_str());
 }
@@ -352,6 +359,16 @@ RunReport Run::run() {
   rep_.wall_seconds = std::chrono::duration<double>(Clock::now() - t0_).count();
   rep_.steps = s_.step - step0_;
   rep_.sim_time = s_.time;
+  if (sleep_active(m_, s_)) {
+    const SleepState& z = s_.sleep;
+    rep_.sleep = true;
+    rep_.sleeping_at_end = sleeping_grains(s_);
+    rep_.mean_awake = rep_.steps > 0 ? (z.awake_grain_steps - awake0_) / double(rep_.steps) : 0;
+    rep_.fell_asleep = z.fell_asleep;
+    rep_.woke = z.woke;
+    rep_.discarded_energy = z.discarded_energy;
+    rep_.discarded_max_speed = z.discarded_max_speed;
+  }
   if (!opt_.out_dir.empty()) {
     if (rep_.status == "ok") sample();
     series_.close();

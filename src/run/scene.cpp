@@ -45,10 +45,20 @@ void SceneRun::add_run_and_observers(JsonObject& j, const Model& m, const RunRep
   run.num("grains", m.n_grains).num("steps", double(rep.steps)).num("sim_time", rep.sim_time);
   run.num("wall_seconds", rep.wall_seconds).num("dt", m.dt).num("kn", m.kn);
   if (threads > 0) run.num("threads", threads);
+  add_sleep_summary(run, rep);
   j.obj("run", run);
   JsonObject obs;
   for (Observer* o : const_cast<SceneRun*>(this)->observers()) o->summary(obs);
   j.obj("observers", obs);
+}
+
+void add_sleep_summary(JsonObject& j, const RunReport& rep) {
+  if (!rep.sleep) return;
+  JsonObject sl;
+  sl.num("sleeping_at_end", double(rep.sleeping_at_end)).num("mean_awake", rep.mean_awake);
+  sl.num("fell_asleep", double(rep.fell_asleep)).num("woke", double(rep.woke));
+  sl.num("discarded_kinetic_energy", rep.discarded_energy).num("discarded_max_speed", rep.discarded_max_speed);
+  j.obj("sleep", sl);
 }
 
 double Scene::bed_top() const { return std::numeric_limits<double>::infinity(); }

@@ -16,9 +16,10 @@ namespace rt {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'G', 'T', 'W', 'C', 'K', 'P', 'T'};
-// 4: history slots of grain–mesh contacts; 3 (rigid bodies, no grain–mesh
-// contacts) and 2 (grains only) are still read.
-constexpr uint32_t kVersion = 4;
+// 5: sleep state (docs/model.md §16); 4 (history slots of grain–mesh
+// contacts), 3 (rigid bodies, no grain–mesh contacts) and 2 (grains only)
+// are still read.
+constexpr uint32_t kVersion = 5;
 
 // Fingerprint of the static grain description a state belongs to.
 uint64_t model_fingerprint(const Model& m) {
@@ -149,6 +150,30 @@ void save_checkpoint(const std::string& path, const Model& m, const State& s) {
   w.vec(s.body_grains.mesh_first);
   w.vec(s.body_grains.mesh_slots);
   w.vec(s.body_points);
+  // Sleep state (model.md §16): flag, then the grid, per-grain and per-cell arrays, counters.
+  const SleepState& z = s.sleep;
+  w.pod<uint8_t>(z.initialized ? 1 : 0);
+  if (z.initialized) {
+    w.pod(z.lo);
+    w.pod(z.cell);
+    w.pod<int32_t>(z.nx);
+    w.pod<int32_t>(z.ny);
+    w.pod<int32_t>(z.nz);
+    w.vec(z.asleep);
+    w.vec(z.f_ref);
+    w.vec(z.f_last);
+    w.vec(z.quiet);
+    w.pod(z.gravity);
+    w.pod<int64_t>(z.next_check);
+    w.pod(z.last_check);
+    w.pod<uint8_t>(z.ref_pending ? 1 : 0);
+    w.pod<int64_t>(z.fell_asleep);
+    w.pod<int64_t>(z.woke);
+    w.pod<int64_t>(z.checks);
+    w.pod(z.awake_grain_steps);
+    w.pod(z.discarded_energy);
+    w.pod(z.discarded_max_speed);
+  }
   const uint64_t sum = fnv1a(w.buf.data(), w.buf.size());
   w.pod(sum);
 
@@ -179,7 +204,7 @@ State load_checkpoint(const std::string& path, const Model& m) {
   char magic[8];
   r.raw(magic, 8);
   const uint32_t version = r.pod<uint32_t>();
-  if (version != kVersion && version != 3 && version != 2)
+  if (version != kVersion && version != 4 && version != 3 && version != 2)
     r.fail("format version " + std::to_string(version) + ", this build reads version " + std::to_string(kVersion));
   const uint64_t n = r.pod<uint64_t>();
   if (n != uint64_t(m.n_grains))
@@ -239,6 +264,36 @@ State load_checkpoint(const std::string& path, const Model& m) {
         r.fail("body contact refers to a missing body or shape");
   } else if (!m.bodies.empty()) {
     r.fail("format version 2 holds no bodies, the scenario has " + std::to_string(m.bodies.size()));
+  }
+  if (version >= 5 && r.pod<uint8_t>() != 0) {
+    SleepState& z = s.sleep;
+    z.lo = r.pod<Vec3>();
+    z.cell = r.pod<double>();
+    z.nx = r.pod<int32_t>();
+    z.ny = r.pod<int32_t>();
+    z.nz = r.pod<int32_t>();
+    if (!(z.cell > 0) || z.nx <= 0 || z.ny <= 0 || z.nz <= 0 || double(z.nx) * z.ny * z.nz > 1e9)
+      r.fail("sleep cell grid is invalid");
+    const size_t cells = size_t(z.nx) * z.ny * z.nz;
+    r.vec(z.asleep, n);
+    r.vec(z.f_ref, n);
+    r.vec(z.f_last, n);
+    r.vec(z.quiet, cells);
+    z.gravity = r.pod<Vec3>();
+    z.next_check = r.pod<int64_t>();
+    z.last_check = r.pod<double>();
+    z.ref_pending = r.pod<uint8_t>() != 0;
+    z.fell_asleep = r.pod<int64_t>();
+    z.woke = r.pod<int64_t>();
+    z.checks = r.pod<int64_t>();
+    z.awake_grain_steps = r.pod<double>();
+    z.discarded_energy = r.pod<double>();
+    z.discarded_max_speed = r.pod<double>();
+    z.cell_flags.assign(cells, 0);
+    z.cell_sum.assign(cells, 0.0);
+    z.cell_count.assign(cells, 0);
+    z.cell_scratch.assign(n, -1);
+    z.initialized = true;
   }
   if (r.pos() + 8 != data.size()) r.fail("unexpected trailing data");
   for (int p : s.pairs.partner)

@@ -445,8 +445,8 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   const Reader rd(source);
   if (!root || !root.IsMap()) throw InputError(source + ": expected a YAML mapping at the top level");
   rd.only(root, "",
-          {"name", "seed", "gravity", "contact", "guards", "materials", "walls", "bodies", "grains", "stages",
-           "output"});
+          {"name", "seed", "gravity", "contact", "guards", "sleep", "materials", "walls", "bodies", "grains",
+           "stages", "output"});
   Scenario sc;
   sc.file = source;
   sc.name = rd.text(root, "", "name", "scenario");
@@ -529,6 +529,18 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   rd.only(gd, "guards", {"max_overlap_ratio", "allow_under_resolved"});
   m.guards.max_overlap_ratio = rd.number(gd, "guards", "max_overlap_ratio", 0.25, 0, 2, true);
   m.guards.allow_under_resolved = rd.boolean(gd, "guards", "allow_under_resolved", false);
+
+  // Sleeping of quiescent regions (docs/model.md §16).
+  const YAML::Node sl = rd.map(root, "", "sleep", false);
+  rd.only(sl, "sleep", {"enabled", "speed", "time", "force", "cell", "check_every", "at_start"});
+  SleepParams& sp = m.sleep;
+  sp.enabled = rd.boolean(sl, "sleep", "enabled", false);
+  sp.speed = rd.number(sl, "sleep", "speed", sp.speed, 0, kInf, true);
+  sp.time = rd.number(sl, "sleep", "time", sp.time, 0, kInf);
+  sp.force = rd.number(sl, "sleep", "force", sp.force, 0, kInf, true);
+  sp.cell = rd.number(sl, "sleep", "cell", sp.cell, 0, kInf);
+  sp.check_every = int(rd.integer(sl, "sleep", "check_every", sp.check_every, 1, 1000000));
+  sp.at_start = rd.boolean(sl, "sleep", "at_start", sp.at_start);
 
   finalize_model(m);
   sc.scene_kn = m.kn;

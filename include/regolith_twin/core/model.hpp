@@ -81,6 +81,25 @@ struct Wall {
 };
 
 // Guard thresholds: a run that crosses them stops with a diagnostic.
+// Sleeping of quiescent regions (docs/model.md §16). Grains are binned in
+// cubic sleep cells; a cell whose grains stay slow and whose contact forces
+// stay steady for a while falls asleep: its grains leave the step (neither
+// integrated nor searched against each other) and keep their springs. A
+// cell wakes when something moving reaches a neighbouring cell (a grain, a
+// body), when the force on one of its grains from awake neighbours, walls or
+// bodies changes by more than a fraction of its weight, or when gravity
+// changes. Thresholds scale with the bed: speed with sqrt(|g| d), time with
+// sqrt(d / |g|), force with the grain's weight (d: mean grain diameter).
+struct SleepParams {
+  bool enabled = false;
+  double speed = 0.1;     // cell RMS speed below speed * sqrt(|g| d) counts as quiet; a grain above it moves
+  double time = 0.05;     // quiet for time * sqrt(d / |g|) before a cell falls asleep
+  double force = 0.5;     // force change above force * m |g| on a grain wakes (sleeping) or keeps awake
+  double cell = 0;        // sleep cell side, m (<= 0: 2 (2 r_max + skin)); at least 2 r_max + skin
+  int check_every = 20;   // at most this many steps between checks (fewer when grains or bodies move fast)
+  bool at_start = true;   // cells quiet at the first check fall asleep at once (a relaxed bed)
+};
+
 struct Guards {
   double max_overlap_ratio = 0.25;  // overlap / smaller radius of the pair
   double min_steps_per_contact_warn = 10;
@@ -135,6 +154,7 @@ struct Model {
   bool any_resistance = false;         // some pair type has rolling or twisting resistance
   int single_grain_material = -1;      // the material of every grain if they share one, else -1
   Guards guards;
+  SleepParams sleep;
 
   double max_radius = 0, min_radius = 0;  // extreme grain radii, m
 };

@@ -124,6 +124,40 @@ struct StepStats {
   double max_disp2 = 0;          // squared max displacement since the last list build, m^2
 };
 
+// Sleep state of the grains and cells (core/sleep.hpp). The per-grain arrays
+// and the cells' quiet times are state (checkpointed); awake, watch and the
+// force pass's entry segments are derived from them.
+struct SleepState {
+  bool initialized = false;
+  Vec3 lo = Vec3::Zero();       // low corner of the cell grid, m
+  double cell = 0;              // cell side, m
+  int nx = 0, ny = 0, nz = 0;   // cells per axis
+  std::vector<uint8_t> asleep;  // 1 while grain i sleeps (n_grains)
+  std::vector<Vec3> f_ref;      // sleeping grains: force of the evaluated contacts at the first pass after the
+                                // evaluated set last changed, N (n_grains)
+  std::vector<Vec3> f_last;     // awake grains: force at the last check, N (n_grains)
+  std::vector<double> quiet;    // per cell: time its awake grains have been quiet, s
+  Vec3 gravity = Vec3::Zero();  // gravity the sleeping grains rest under
+  long next_check = 0;          // step of the next check
+  double last_check = 0;        // time of the last check, s
+  bool ref_pending = true;      // f_ref is taken at the next force pass
+  // statistics
+  long fell_asleep = 0, woke = 0;  // grain transitions
+  long checks = 0;
+  double awake_grain_steps = 0;    // sum over steps of the awake grains (their mean: work done)
+  double discarded_energy = 0;     // kinetic energy zeroed when grains fell asleep, J
+  double discarded_max_speed = 0;  // fastest grain put to sleep, m/s
+  // derived (not checkpointed)
+  std::vector<int> awake;          // ids of the awake grains, ascending
+  std::vector<int> watch;          // sleeping grains with an evaluated contact (checked every step)
+  std::vector<int> cell_scratch;   // per grain cell index (checks)
+  std::vector<uint8_t> cell_flags; // per cell flags (checks)
+  std::vector<double> cell_sum;    // per cell sum of squared speeds (checks)
+  std::vector<int> cell_count;     // per cell awake grains (checks)
+  std::vector<uint8_t> woken;      // grains woken by this update (scratch)
+  std::vector<uint8_t> touch;      // grains touching a grain, wall or body (checks)
+};
+
 struct State {
   double time = 0;              // simulated time, s
   long step = 0;                // steps taken
@@ -159,6 +193,10 @@ struct State {
   std::vector<int> thread_row_begin;  // (n_threads + 1)
   std::vector<int> thread_wall_begin; // (partitions + 1) wall entries of grains [n q/P, n (q+1)/P)
   std::vector<int> thread_body_begin; // grain–body entries, split at grain boundaries
+  // Entry segments [seg_begin, seg_end) of the pair list evaluated by each
+  // partition: partition p takes segments [thread_seg_begin[p], thread_seg_begin[p+1]).
+  // Without sleeping, one segment per partition (its rows' entries).
+  std::vector<int> seg_begin, seg_end, thread_seg_begin;
   std::vector<ThreadScratch> scratch;
 
   // Cell-list scratch (reused by every rebuild).
@@ -179,9 +217,13 @@ struct State {
   bool hold_body_springs = false;
 
   StepStats stats;
+  SleepState sleep;
   bool log_contacts = false;  // record every contact of each force pass in scratch[p].log
   bool scalar_kernel = false;  // evaluate contacts one at a time (reference for the batched kernel)
 };
+
+// Sleeping is on and its state initialised (core/sleep.hpp).
+inline bool sleep_active(const Model& m, const State& s) { return m.sleep.enabled && s.sleep.initialized; }
 
 // A state for model m: zero kinematics (callers set pos, vel, omega), every
 // buffer sized, lists built at the first step.

@@ -63,6 +63,13 @@ struct RunReport {
   double max_overlap_ratio = 0;
   bool ended_by_observer = false;
   std::vector<StageReport> stages;
+  // Sleeping (docs/model.md §16), when on: grains asleep at the end, mean
+  // awake grains per step of this run, transitions, what was discarded.
+  bool sleep = false;
+  long sleeping_at_end = 0;
+  double mean_awake = 0;
+  long fell_asleep = 0, woke = 0;
+  double discarded_energy = 0, discarded_max_speed = 0;
 };
 
 class Run {
@@ -120,6 +127,7 @@ class Run {
   double t_stage_end_ = 0, next_sample_ = 0, next_check_ = 0, next_quench_ = 0;
   double t_start_ = 0, t_ramp0_ = 0;
   long step0_ = 0;
+  double awake0_ = 0;  // SleepState::awake_grain_steps at the start
   Vec3 g_from_ = Vec3::Zero();
   std::vector<uint8_t> held_, drop_;
   std::vector<int> old_to_new_;

@@ -29,6 +29,9 @@ struct SceneOptions {
 class JsonObject;
 
 // One run of a prepared scene: its observers, and its outputs written from them.
+// The run's sleep figures (docs/model.md §16) as j["sleep"], when sleeping was on.
+void add_sleep_summary(JsonObject& j, const RunReport& rep);
+
 class SceneRun {
  public:
   explicit SceneRun(std::string kind = "") : kind_(std::move(kind)) {}

@@ -63,7 +63,7 @@ LandingOutcome LandingRun::outcome(const RunReport& rep, bool final) const {
 
 void LandingRun::write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
                                int threads) const {
-  write_landing_summary(path, scene_, outcome(rep, true), threads);
+  write_landing_summary(path, scene_, outcome(rep, true), threads, &rep);
 }
 
 void LandingRun::write_files(const std::string& dir, const Model& m, const State& s, const RunReport& rep) const {
@@ -156,7 +156,8 @@ std::unique_ptr<LandingScene> prepare_landing(const std::string& file, const std
   return std::unique_ptr<LandingScene>(static_cast<LandingScene*>(sc.release()));
 }
 
-void write_landing_summary(const std::string& path, const LandingScene& ls, const LandingOutcome& o, int threads) {
+void write_landing_summary(const std::string& path, const LandingScene& ls, const LandingOutcome& o, int threads,
+                           const RunReport* rep) {
   const LandingSpec& spec = ls.spec;
   const Model& m = ls.sc.model;
   JsonObject j;
@@ -192,6 +193,7 @@ void write_landing_summary(const std::string& path, const LandingScene& ls, cons
   JsonObject run;
   run.num("steps", double(o.steps)).num("wall_seconds", o.wall_seconds).num("dt", m.dt).num("kn", m.kn);
   if (threads > 0) run.num("threads", threads);
+  if (rep) add_sleep_summary(run, *rep);
   j.obj("run", run);
   j.write(path);
 }

@@ -64,6 +64,7 @@ std::unique_ptr<LandingScene> prepare_landing(const std::string& file, const std
                                               const SceneOptions& opt);
 
 // summary.json of a landing: input, bed, outcome, run figures.
-void write_landing_summary(const std::string& path, const LandingScene& ls, const LandingOutcome& o, int threads);
+void write_landing_summary(const std::string& path, const LandingScene& ls, const LandingOutcome& o, int threads,
+                           const RunReport* rep = nullptr);
 
 }  // namespace rt

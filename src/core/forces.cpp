@@ -14,9 +14,48 @@
 namespace rt {
 namespace {
 
-// Grain–grain contacts of rows [rb, re) into F, T. Arrays are taken as
-// restrict pointers and row i's force is summed locally, so the compiler
-// keeps grain i in registers while it walks the row.
+// Law input of touching list entry k (grains i < j, d = x_j - x_i, dist2 = |d|^2).
+inline PairInput pair_input(const State& s, int k, int i, int j, const Vec3& d, double dist2, double ri, double rj) {
+  const double rs = ri + rj;
+  const double inv_dist = 1.0 / std::sqrt(dist2);
+  PairInput in;
+  in.n = d * inv_dist;
+  in.x = rs - dist2 * inv_dist;
+  in.li = ri - 0.5 * in.x;
+  in.lj = rj - 0.5 * in.x;
+  in.reff = ri * rj / rs;
+  in.sqrt_mstar = s.pairs.sqrt_mstar[k];
+  in.vrel = s.vel[j] - s.vel[i];
+  in.wi = s.omega[i];
+  in.wj = s.omega[j];
+  in.vrel_mid = s.vel_mid[j] - s.vel_mid[i];
+  in.wi_mid = s.omega_mid[i];
+  in.wj_mid = s.omega_mid[j];
+  return in;
+}
+
+// Law input of grain i against a wall at gap `gap` (the wall at rest).
+inline PairInput wall_input(const Model& m, const State& s, int i, const WallGap& gap) {
+  const double ri = m.grain_radius[i];
+  PairInput in;
+  in.n = gap.n;
+  in.x = gap.overlap;
+  in.li = ri - 0.5 * in.x;
+  in.lj = 0;
+  in.reff = ri;
+  in.sqrt_mstar = std::sqrt(m.grain_mass[i]);
+  in.vrel = -s.vel[i];
+  in.wi = s.omega[i];
+  in.wj.setZero();
+  in.vrel_mid = -s.vel_mid[i];
+  in.wi_mid = s.omega_mid[i];
+  in.wj_mid.setZero();
+  return in;
+}
+
+// Grain–grain contacts of rows [rb, re) into F, T (the one-pair kernel: the
+// reference of the batched one, and the pass that logs contacts). Row i's
+// force is summed locally and added once.
 template <ContactModel M, bool Resist>
 void pair_rows(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec3* __restrict T,
                ThreadScratch& sc) {
@@ -24,10 +63,6 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec
   const double dt = m.dt;
   const int nm = m.n_materials();
   const Vec3* __restrict pos = s.pos.data();
-  const Vec3* __restrict vel = s.vel.data();
-  const Vec3* __restrict omega = s.omega.data();
-  const Vec3* __restrict vel_mid = s.vel_mid.data();
-  const Vec3* __restrict omega_mid = s.omega_mid.data();
   const double* __restrict radius = m.grain_radius.data();
   const int* __restrict material = m.grain_material.data();
   const int* __restrict partner = pl.partner.data();
@@ -38,7 +73,7 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec
   int max_grain = sc.max_overlap_grain;
   const uint8_t* asleep = sleep_active(m, s) ? s.sleep.asleep.data() : nullptr;
   for (int i = rb; i < re; ++i) {
-    const Vec3 xi = pos[i], vi = vel[i], wi = omega[i], vi_mid = vel_mid[i], wi_mid = omega_mid[i];
+    const Vec3 xi = pos[i];
     const double ri = radius[i];
     const PairLaw* laws = &m.pair_law[material[i] * nm];
     Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
@@ -60,20 +95,7 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec
         continue;
       }
       touching[k] = 1;
-      const double inv_dist = 1.0 / std::sqrt(dist2);
-      PairInput in;
-      in.n = d * inv_dist;
-      in.x = rs - dist2 * inv_dist;
-      in.li = ri - 0.5 * in.x;
-      in.lj = rj - 0.5 * in.x;
-      in.reff = ri * rj / rs;
-      in.sqrt_mstar = pl.sqrt_mstar[k];
-      in.vrel = vel[j] - vi;
-      in.wi = wi;
-      in.wj = omega[j];
-      in.vrel_mid = vel_mid[j] - vi_mid;
-      in.wi_mid = wi_mid;
-      in.wj_mid = omega_mid[j];
+      const PairInput in = pair_input(s, k, i, j, d, dist2, ri, rj);
       const PairLaw& law = laws[material[j]];
       const PairOutput out =
           pair_contact<M, Resist>(law, in, PairSprings{pl.spring_t[k], pl.spring_r[k], pl.spring_w[k]}, dt);
@@ -509,19 +531,7 @@ void wall_entries(const Model& m, State& s, int kb, int ke, ThreadScratch& sc) {
       continue;
     }
     wl.touching[k] = 1;
-    PairInput in;
-    in.n = gap.n;
-    in.x = gap.overlap;
-    in.li = ri - 0.5 * in.x;
-    in.lj = 0;
-    in.reff = ri;
-    in.sqrt_mstar = std::sqrt(m.grain_mass[i]);
-    in.vrel = -s.vel[i];
-    in.wi = s.omega[i];
-    in.wj.setZero();
-    in.vrel_mid = -s.vel_mid[i];
-    in.wi_mid = s.omega_mid[i];
-    in.wj_mid.setZero();
+    const PairInput in = wall_input(m, s, i, gap);
     const PairLaw& law = m.law(m.grain_material[i], w.law_material);
     const PairOutput out =
         pair_contact<M, Resist>(law, in, PairSprings{wl.spring_t[k], wl.spring_r[k], wl.spring_w[k]}, dt);
@@ -819,20 +829,7 @@ void woken_contacts(const Model& m, State& s, const std::vector<uint8_t>& woken)
     const double ri = m.grain_radius[i], rj = m.grain_radius[j], rs = ri + rj;
     const double dist2 = d.squaredNorm();
     if (dist2 >= rs * rs) continue;
-    const double inv_dist = 1.0 / std::sqrt(dist2);
-    PairInput in;
-    in.n = d * inv_dist;
-    in.x = rs - dist2 * inv_dist;
-    in.li = ri - 0.5 * in.x;
-    in.lj = rj - 0.5 * in.x;
-    in.reff = ri * rj / rs;
-    in.sqrt_mstar = pl.sqrt_mstar[k];
-    in.vrel = s.vel[j] - s.vel[i];
-    in.wi = s.omega[i];
-    in.wj = s.omega[j];
-    in.vrel_mid = s.vel_mid[j] - s.vel_mid[i];
-    in.wi_mid = s.omega_mid[i];
-    in.wj_mid = s.omega_mid[j];
+    const PairInput in = pair_input(s, k, i, j, d, dist2, ri, rj);
     Vec3 st = pl.spring_t[k], sr = pl.spring_r[k];
     double sw = pl.spring_w[k];
     const PairLaw& law = m.pair_law[m.grain_material[i] * nm + m.grain_material[j]];
@@ -854,19 +851,7 @@ void woken_contacts(const Model& m, State& s, const std::vector<uint8_t>& woken)
     const double ri = m.grain_radius[i];
     const WallGap gap = wall_gap(w, s.pos[i], ri);
     if (gap.overlap <= 0) continue;
-    PairInput in;
-    in.n = gap.n;
-    in.x = gap.overlap;
-    in.li = ri - 0.5 * in.x;
-    in.lj = 0;
-    in.reff = ri;
-    in.sqrt_mstar = std::sqrt(m.grain_mass[i]);
-    in.vrel = -s.vel[i];
-    in.wi = s.omega[i];
-    in.wj.setZero();
-    in.vrel_mid = -s.vel_mid[i];
-    in.wi_mid = s.omega_mid[i];
-    in.wj_mid.setZero();
+    const PairInput in = wall_input(m, s, i, gap);
     Vec3 st = wl.spring_t[k], sr = wl.spring_r[k];
     double sw = wl.spring_w[k];
     const PairLaw& law = m.law(m.grain_material[i], w.law_material);

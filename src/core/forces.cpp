@@ -53,11 +53,12 @@ inline PairInput wall_input(const Model& m, const State& s, int i, const WallGap
   return in;
 }
 
-// Grain–grain contacts of rows [rb, re) into F, T (the one-pair kernel: the
-// reference of the batched one, and the pass that logs contacts). Row i's
-// force is summed locally and added once.
+// Grain–grain contacts of the list segments [gb, ge) (State::seg_begin,
+// seg_end) into F, T: the one-pair kernel, reference of the batched one and
+// the pass that logs contacts. Each owner's force is summed locally and
+// added once its entries end, as the batched kernel does.
 template <ContactModel M, bool Resist>
-void pair_rows(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec3* __restrict T,
+void pair_rows(const Model& m, State& s, int gb, int ge, Vec3* __restrict F, Vec3* __restrict T,
                ThreadScratch& sc) {
   PairList& pl = s.pairs;
   const double dt = m.dt;
@@ -66,23 +67,27 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec
   const double* __restrict radius = m.grain_radius.data();
   const int* __restrict material = m.grain_material.data();
   const int* __restrict partner = pl.partner.data();
-  const int* __restrict row = pl.row_start.data();
+  const int* __restrict owner = pl.owner.data();
   uint8_t* __restrict touching = pl.touching.data();
   long contacts = 0;
   double max_ratio = sc.max_overlap_ratio;
   int max_grain = sc.max_overlap_grain;
-  const uint8_t* asleep = sleep_active(m, s) ? s.sleep.asleep.data() : nullptr;
-  for (int i = rb; i < re; ++i) {
-    const Vec3 xi = pos[i];
-    const double ri = radius[i];
-    const PairLaw* laws = &m.pair_law[material[i] * nm];
-    Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
-    const bool idle_i = asleep && (asleep[i] || m.grain_inv_mass[i] == 0);
-    for (int k = row[i]; k < row[i + 1]; ++k) {
+  int i = -1;
+  Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
+  for (int seg = gb; seg < ge; ++seg)
+    for (int k = s.seg_begin[seg]; k < s.seg_end[seg]; ++k) {
+      if (owner[k] != i) {
+        if (i >= 0) {
+          F[i] += fi;
+          T[i] += ti;
+        }
+        i = owner[k];
+        fi.setZero();
+        ti.setZero();
+      }
       const int j = partner[k];
-      if (idle_i && (asleep[j] || m.grain_inv_mass[j] == 0)) continue;  // both asleep: not evaluated (model.md §16)
-      const Vec3 d = pos[j] - xi;
-      const double rj = radius[j];
+      const Vec3 d = pos[j] - pos[i];
+      const double ri = radius[i], rj = radius[j];
       const double rs = ri + rj;
       const double dist2 = d.squaredNorm();
       if (dist2 >= rs * rs) {
@@ -96,7 +101,7 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec
       }
       touching[k] = 1;
       const PairInput in = pair_input(s, k, i, j, d, dist2, ri, rj);
-      const PairLaw& law = laws[material[j]];
+      const PairLaw& law = m.pair_law[material[i] * nm + material[j]];
       const PairOutput out =
           pair_contact<M, Resist>(law, in, PairSprings{pl.spring_t[k], pl.spring_r[k], pl.spring_w[k]}, dt);
       fi += out.force_i;
@@ -113,6 +118,7 @@ void pair_rows(const Model& m, State& s, int rb, int re, Vec3* __restrict F, Vec
         max_grain = i;
       }
     }
+  if (i >= 0) {
     F[i] += fi;
     T[i] += ti;
   }
@@ -709,6 +715,7 @@ void force_pass(const Model& m, State& s) {
   }
   const bool bodies = !m.bodies.empty();
   const bool batched = !s.log_contacts && !s.scalar_kernel;
+  const bool sleeping = sleep_active(m, s);
   long wall_contacts = 0, body_contacts = 0;
 #pragma omp parallel if (n >= m.parallel_min_grains)
   {
@@ -735,7 +742,7 @@ void force_pass(const Model& m, State& s) {
       else if (batched)
         pair_rows_batched<M, false, Resist>(m, s, gb, ge, F, T, sc);
       else
-        pair_rows<M, Resist>(m, s, s.thread_row_begin[p], s.thread_row_begin[p + 1], F, T, sc);
+        pair_rows<M, Resist>(m, s, gb, ge, F, T, sc);
     }  // (implied barrier)
     // Merge and walls, one block of grains at a time per thread (block q is
     // grains [n q/P, n (q+1)/P) and the wall entries of those grains): every
@@ -756,6 +763,18 @@ void force_pass(const Model& m, State& s) {
         ThreadScratch& sc = s.scratch[p];
         Vec3* __restrict pf = sc.force.data();
         Vec3* __restrict pt = sc.torque.data();
+        if (sleeping) {  // the grains it wrote, from its list (the same sums, in the same order)
+          const auto b = std::lower_bound(sc.touched.begin(), sc.touched.end(), gb);
+          const auto e = std::lower_bound(b, sc.touched.end(), ge);
+          for (auto it = b; it != e; ++it) {
+            const int i = *it;
+            force[i] += pf[i];
+            torque[i] += pt[i];
+            pf[i].setZero();
+            pt[i].setZero();
+          }
+          continue;
+        }
         const int lo = std::max(gb, sc.touched_lo), hi = std::min(ge, sc.touched_hi);
         for (int i = lo; i < hi; ++i) {
           force[i] += pf[i];

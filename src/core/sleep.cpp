@@ -56,7 +56,8 @@ void mark_sphere(SleepState& z, const Vec3& c, double reach, uint8_t flag) {
 
 void init_sleep(const Model& m, State& s) {
   SleepState& z = s.sleep;
-  const SleepThresholds th = sleep_thresholds(m);
+  z.d_mean = mean_diameter(m);
+  const SleepThresholds th = sleep_thresholds(m, z.d_mean);
   const int n = m.n_grains;
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
   for (int i = 0; i < n; ++i) {
@@ -97,8 +98,9 @@ enum : uint8_t { kMoving = 1, kAgitated = 2, kWake = 4, kHasSleeper = 8, kBody =
 
 }  // namespace
 
-SleepThresholds sleep_thresholds(const Model& m) {
-  const double d = mean_diameter(m);
+SleepThresholds sleep_thresholds(const Model& m) { return sleep_thresholds(m, mean_diameter(m)); }
+
+SleepThresholds sleep_thresholds(const Model& m, double d) {
   const double g = m.gravity.norm();
   const double reach = 2 * m.max_radius + m.skin;
   SleepThresholds t{};
@@ -168,6 +170,16 @@ void sleep_segments(const Model& m, State& s) {
     if (q == 0) lo = 0;  // partition 0 writes State::force from grain 0 on
     sc.touched_lo = std::min(lo, hi);
     sc.touched_hi = hi;
+    // The grains it writes, for a merge that visits only them.
+    sc.touched.clear();
+    if (q == 0) continue;
+    for (int g = s.thread_seg_begin[q]; g < s.thread_seg_begin[q + 1]; ++g)
+      for (int k = s.seg_begin[g]; k < s.seg_end[g]; ++k) {
+        if (sc.touched.empty() || sc.touched.back() != pl.owner[k]) sc.touched.push_back(pl.owner[k]);
+        sc.touched.push_back(pl.partner[k]);
+      }
+    std::sort(sc.touched.begin(), sc.touched.end());
+    sc.touched.erase(std::unique(sc.touched.begin(), sc.touched.end()), sc.touched.end());
   }
   // Sleeping grains whose evaluated contacts can change: a partner awake, or a body.
   std::vector<int>& mark = z.cell_scratch;
@@ -218,7 +230,7 @@ void update_sleep(const Model& m, State& s) {
     init_sleep(m, s);
     s.rebuild_requested = true;  // lists and segments follow the sleep flags from the next step
   }
-  const SleepThresholds th = sleep_thresholds(m);
+  const SleepThresholds th = sleep_thresholds(m, z.d_mean);
   z.awake_grain_steps += double(z.awake.size());
   bool woke_any = false, slept_any = false;
   std::fill(z.cell_flags.begin(), z.cell_flags.end(), 0);

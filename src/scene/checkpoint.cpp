@@ -156,6 +156,7 @@ void save_checkpoint(const std::string& path, const Model& m, const State& s) {
   if (z.initialized) {
     w.pod(z.lo);
     w.pod(z.cell);
+    w.pod(z.d_mean);
     w.pod<int32_t>(z.nx);
     w.pod<int32_t>(z.ny);
     w.pod<int32_t>(z.nz);
@@ -269,6 +270,7 @@ State load_checkpoint(const std::string& path, const Model& m) {
     SleepState& z = s.sleep;
     z.lo = r.pod<Vec3>();
     z.cell = r.pod<double>();
+    z.d_mean = r.pod<double>();
     z.nx = r.pod<int32_t>();
     z.ny = r.pod<int32_t>();
     z.nz = r.pod<int32_t>();

@@ -187,9 +187,9 @@ TEST(SleepTest, DroppedGrainWakesItsCellsAndTheChain) {
 }
 
 TEST(SleepTest, RestingBodyDoesNotSinkIntoSleepingBed) {
-  // A 0.2 kg block set down on the bed and left to come to rest (bed awake),
-  // then run on with sleeping off and on: with sleeping on, the bed under it
-  // sleeps and the block stays where it rests.
+  // A 30 g block set down on the bed and left to come to rest (bed awake), then
+  // run on with sleeping off and on: with sleeping on, the grains under it
+  // fall asleep and the block stays where it rests.
   const Scene& bed = settled_bed();
   const int n = bed.m.n_grains;
   Scene sc = bed;
@@ -198,7 +198,7 @@ TEST(SleepTest, RestingBodyDoesNotSinkIntoSleepingBed) {
   m.materials.back().structure = true;
   rt::BodyModel b;
   b.name = "block";
-  b.mass = 0.2;
+  b.mass = 0.03;
   const Vec3 ext(0.05, 0.05, 0.02);
   b.inertia = Vec3(ext.y() * ext.y() + ext.z() * ext.z(), ext.x() * ext.x() + ext.z() * ext.z(),
                    ext.x() * ext.x() + ext.y() * ext.y()) *
@@ -220,25 +220,38 @@ TEST(SleepTest, RestingBodyDoesNotSinkIntoSleepingBed) {
     if (std::fabs(s.pos[i].x() - 0.5 * kL) < 0.5 * ext.x() + kR && std::fabs(s.pos[i].y() - 0.5 * kL) < 0.5 * ext.y() + kR)
       under = std::max(under, s.pos[i].z() + m.grain_radius[i]);
   s.bodies[0].pos = Vec3(0.5 * kL, 0.5 * kL, under + 0.5 * ext.z() + 1e-4);
-  run(m, s, 0.3);  // sets down, comes to rest
+  run(m, s, 0.6);  // sets down, comes to rest
   ASSERT_LT(s.bodies[0].vel.norm(), 0.01);
   const double z0 = s.bodies[0].pos.z();
   double z_end[2];
   long asleep_end = 0;
+  int carrying = 0, carrying_asleep = 0;
   for (int on = 0; on < 2; ++on) {
     rt::Model mm = m;
     rt::State ss = s;
     mm.sleep.enabled = on == 1;
     run(mm, ss, 0.3);
     z_end[on] = ss.bodies[0].pos.z();
-    if (on) asleep_end = rt::sleeping_grains(ss);
+    if (on) {
+      asleep_end = rt::sleeping_grains(ss);
+      // The grains that carry the block: touching it from below.
+      const double bottom = ss.bodies[0].pos.z() - 0.5 * ext.z();
+      for (int k = 0; k < ss.body_grains.size(); ++k)
+        if (ss.body_grains.touching[k] && ss.pos[ss.body_grains.grain[k]].z() < bottom) {
+          ++carrying;
+          carrying_asleep += ss.sleep.asleep[ss.body_grains.grain[k]];
+        }
+    }
   }
+  // Not vacuous: the bed, and grains that carry the block, sleep.
   EXPECT_GT(asleep_end, n / 2) << "the bed under the resting block sleeps";
+  EXPECT_GE(carrying_asleep, carrying / 2) << "the grains that carry the block sleep";
   EXPECT_LT(std::fabs(z_end[1] - z0), 0.1 * kR) << "the block does not sink into the sleeping bed";
   EXPECT_LT(std::fabs(z_end[1] - z_end[0]), 0.1 * kR) << "the block rests where it rests on the bed left awake";
   RecordProperty("block_sink_over_r", rt::test::figure((z_end[1] - z0) / kR));
   RecordProperty("block_vs_awake_over_r", rt::test::figure((z_end[1] - z_end[0]) / kR));
   RecordProperty("asleep_of_1200", rt::test::figure(double(asleep_end)));
+  RecordProperty("carrying_asleep", std::to_string(carrying_asleep) + " of " + std::to_string(carrying));
 }
 
 TEST(SleepTest, SameResultForAnyThreadCountAndAcrossResume) {

@@ -27,7 +27,9 @@ struct SleepThresholds {
   double cell;   // m
   double margin; // how far a grain may travel between checks without reaching a sleeping grain unseen, m
 };
-SleepThresholds sleep_thresholds(const Model& m);
+// d: the mean grain diameter (State::sleep.d_mean once sleeping has started).
+SleepThresholds sleep_thresholds(const Model& m, double d);
+SleepThresholds sleep_thresholds(const Model& m);  // d from the model's grains
 
 // Number of sleeping grains.
 long sleeping_grains(const State& s);

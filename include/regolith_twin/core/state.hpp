@@ -101,6 +101,7 @@ struct ThreadScratch {
   std::vector<Vec3> force;      // force on grains, N (thread 0 writes State::force)
   std::vector<Vec3> torque;     // torque, N m
   int touched_lo = 0, touched_hi = 0;  // index range written by this partition
+  std::vector<int> touched;       // with sleeping: the grains this partition writes, ascending (merged by list)
   double max_overlap_ratio = 0;
   int max_overlap_grain = -1;
   long contacts = 0;
@@ -131,6 +132,7 @@ struct SleepState {
   bool initialized = false;
   Vec3 lo = Vec3::Zero();       // low corner of the cell grid, m
   double cell = 0;              // cell side, m
+  double d_mean = 0;            // mean grain diameter when sleeping started, m (the thresholds' scale)
   int nx = 0, ny = 0, nz = 0;   // cells per axis
   std::vector<uint8_t> asleep;  // 1 while grain i sleeps (n_grains)
   std::vector<Vec3> f_ref;      // sleeping grains: force of the evaluated contacts at the first pass after the

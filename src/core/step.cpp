@@ -64,6 +64,7 @@ void step(const Model& m, State& s) {
   finish_kick_bodies(m, s, 0.5 * m.dt);
   s.time += m.dt;
   ++s.step;
+  s.ticks += s.tick_len;
   check_guards(m, s);                                              // guards
   update_sleep(m, s);                                              // sleep: wake and put quiet cells to sleep
 }

@@ -41,7 +41,7 @@ void Ejecta::prepare(Model& m, State& s) {
 }
 
 bool Ejecta::after_step(Model& m, State& s) {
-  if (s.step % every_ != 0) return false;
+  if (!ticks_crossed(s, every_)) return false;
   for (int i = 0; i < m.n_grains; ++i)
     if (!flag_[i] && !above0_[i] && s.pos[i].z() > height_) {
       flag_[i] = 1;
@@ -64,7 +64,7 @@ void ActiveZone::prepare(Model& m, State& s) {
 }
 
 bool ActiveZone::after_step(Model& m, State& s) {
-  if (s.step % every_ == 0) update(m, s, s.bodies[body_].pos, false);
+  if (ticks_crossed(s, every_)) update(m, s, s.bodies[body_].pos, false);
   return false;
 }
 
@@ -166,7 +166,7 @@ void RegionCount::row(const Model& m, const State& s, std::vector<double>& out) 
 namespace rt {
 
 bool Escape::leaving(const Model& m, const State& s, std::vector<uint8_t>& drop) {
-  if (s.step % every_ != 0) return false;
+  if (!ticks_crossed(s, every_)) return false;
   bool any = false;
   for (int i = 0; i < m.n_grains; ++i) {
     const Vec3& p = s.pos[i];

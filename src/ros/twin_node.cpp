@@ -248,6 +248,7 @@ void TwinNode::loop() {
       paused_ = true;
       failure_ = e.what();
       pending_steps_ = 0;
+      pending_until_ = -1;
       step_cv_.notify_all();
       ROS_ERROR("twin_node: %s (the run is stopped; reset or load a checkpoint to go on)", e.what());
       publish_diagnostics(diagnostic_msgs::DiagnosticStatus::ERROR, failure_);
@@ -255,7 +256,17 @@ void TwinNode::loop() {
       on_end();
       continue;
     }
-    if (pending_steps_ > 0 && --pending_steps_ == 0) step_cv_.notify_all();
+    if (pending_steps_ > 0) {
+      if (pending_until_ >= 0) {  // a span of simulated time: done once the next step would pass its end
+        if (twin_->state().time >= pending_until_ - 0.5 * twin_->model().dt) pending_steps_ = 0;
+      } else {
+        --pending_steps_;
+      }
+      if (pending_steps_ == 0) {
+        pending_until_ = -1;
+        step_cv_.notify_all();
+      }
+    }
     after_step(false);
     if (twin_->ended() && !end_handled_) on_end();
     lk.unlock();
@@ -729,7 +740,14 @@ bool TwinNode::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response
 
 bool TwinNode::on_step(regolith_twin::Step::Request& req, regolith_twin::Step::Response& res) {
   std::unique_lock<std::mutex> lk(mu_);
-  if (req.steps <= 0 || req.steps > 100000000) {
+  const bool by_time = req.duration != 0;
+  if (by_time && req.steps != 0) {
+    res.success = false;
+    res.message = "give steps or duration, not both";
+  } else if (by_time && !(req.duration > 0 && req.duration <= 1e6)) {
+    res.success = false;
+    res.message = "duration = " + std::to_string(req.duration) + " s: allowed range (0, 1e6]";
+  } else if (!by_time && (req.steps <= 0 || req.steps > 100000000)) {
     res.success = false;
     res.message = "steps = " + std::to_string(req.steps) + ": allowed range [1, 100000000]";
   } else if (!paused_) {
@@ -742,7 +760,8 @@ bool TwinNode::on_step(regolith_twin::Step::Request& req, regolith_twin::Step::R
     res.success = false;
     res.message = "another step request is in progress";
   } else {
-    pending_steps_ = req.steps;
+    pending_steps_ = by_time ? 1 : req.steps;  // by time: one pending until the span is done
+    pending_until_ = by_time ? twin_->state().time + req.duration : -1;
     cv_.notify_all();
     step_cv_.wait(lk, [&] { return pending_steps_ == 0 || !running_; });
     res.success = !failed_ && running_;

@@ -62,12 +62,13 @@ RelaxedBed relax_bed(Scenario& sc, const State& s0, const std::vector<int>& plac
   RunOptions ro;
   ro.out_dir = opt.relax_out;
   ro.progress_every = opt.quiet ? 0 : 5.0;
-  // The relaxation runs on a copy of the scenario without sleeping: a bed is
-  // prepared by the same dynamics whatever the scene later skips, and the
-  // stages' settings (gravity, stiffness scale) do not stay in the scene's
+  // The relaxation runs on a copy of the scenario without sleeping or a
+  // stiffness schedule: a bed is prepared by the same dynamics whatever the
+  // scene later skips, and the stages' settings (gravity, stiffness scale) do not stay in the scene's
   // model, as they do not when the bed comes from the cache.
   Scenario relax = sc;
   relax.model.sleep.enabled = false;
+  relax.model.schedule.enabled = false;
   const RunReport rr = run_scenario(relax, out.state, ro);
   if (rr.status != "ok") throw BlowUpError("bed relaxation: " + rr.message);
   if (!opt.quiet)

@@ -83,6 +83,7 @@ bool Run::settle() {
     for (Observer* o : obs_) o->prepare(m_, s_);
     if (!s_.forces_valid) prime(m_, s_);
     for (Observer* o : obs_) o->start(m_, s_);
+    schedule_start();
     if (!opt_.out_dir.empty()) {
       make_dirs(opt_.out_dir);
       std::vector<std::string> cols = {"t"};
@@ -235,10 +236,12 @@ bool Run::advance() {
     s_.vel[held_ids_[h]].setZero();
     s_.omega[held_ids_[h]].setZero();
   }
+  const int n_before = m_.n_grains;
   add_grains();
   bool end = false;
   for (Observer* o : obs_) end = o->after_step(m_, s_) || end;
   remove_leaving();
+  schedule_check(m_.n_grains > n_before);
   if (end) {
     rep_.ended_by_observer = true;
     end_stage("observer");
@@ -336,8 +339,124 @@ void Run::progress() {
     std::snprintf(b, sizeof b, "  awake %zu", s_.sleep.awake.size());
     text += b;
   }
+  if (sched_on_) {
+    char b[64];
+    std::snprintf(b, sizeof b, "  dt %.3g s", m_.dt);
+    text += b;
+  }
   std::fprintf(stderr, "%s%s  %.3g steps/s  %.3g grain-steps/s  %s\n", head, text.c_str(), steps_s,
                steps_s * m_.n_grains, eta.c_str());
+}
+
+// --- stiffness schedule (docs/model.md §17) ----------------------------------
+
+void Run::schedule_start() {
+  sched_on_ = m_.schedule.enabled;
+  if (!sched_on_) return;
+  if (!(m_.schedule.speed > 0)) throw InputError("schedule.speed: the design speed must be > 0 m/s");
+  for (const Stage& st : plan_.stages)
+    if (st.stiffness_scale > 0)
+      throw InputError("stage '" + st.name + "' sets a stiffness scale and the stiffness schedule "
+                       "(schedule.enabled) sets k_n too: use one of them");
+  // The model is the scene's (a resumed state carries the factor it ran at).
+  sched_kn0_ = m_.kn;
+  sched_body_kn0_ = m_.body_kn;
+  sched_dt0_ = m_.dt;
+  // Three durations of the longest contact, in steps (the same at any factor).
+  double steps = 0;
+  for (const PairResolution& r : pair_resolution(m_, m_.schedule.speed))
+    if (r.label.rfind("body-body", 0) != 0) steps = std::max(steps, r.steps);  // contacts of grains
+  sched_hold_ = std::max(1L, long(std::ceil(3 * steps)));
+  ScheduleState& q = s_.schedule;
+  if (!q.started) {  // a fresh start: the grains' speeds are measured now
+    q = ScheduleState{};
+    q.started = true;
+    q.t_start = s_.time;
+    q.dt_min = q.dt_max = m_.dt;
+    schedule_check(true);
+  } else if (q.scale != 1.0) {  // a resumed state runs on at the factor it was saved with
+    set_stiffness_scale(q.scale, false);
+  }
+}
+
+void Run::set_stiffness_scale(double scale, bool account) {
+  ScheduleState& q = s_.schedule;
+  const double el_old = account ? energy(m_, s_).elastic : 0.0;
+  m_.kn = sched_kn0_ * scale;
+  if (sched_body_kn0_ > 0) m_.body_kn = sched_body_kn0_ * scale;
+  m_.dt = sched_dt0_ / std::sqrt(scale);
+  finalize_model(m_);
+  s_.tick_len = m_.dt / sched_dt0_;
+  if (account) {
+    // Live contacts keep their overlaps and springs: their elastic energy
+    // changes with k_n (Σ ½ Δk x² and the spring terms that scale with it).
+    const Energy e = energy(m_, s_);
+    const double d = e.elastic - el_old, kin = e.kinetic();
+    if (scale > q.scale) {
+      ++q.raised;
+      q.injected += d;
+      q.max_injected_fraction = std::max(q.max_injected_fraction, kin > 0 ? d / kin : (d > 0 ? INFINITY : 0.0));
+    } else {
+      ++q.lowered;
+      q.released -= d;
+    }
+    s_.forces_valid = false;  // forces of the new law before the next step
+    if (opt_.progress_every > 0)
+      std::fprintf(stderr, "[%s] t = %.6g s: k_n %.4g -> %.4g N/m (x%.3g of the scene's), dt %.4g s%s\n",
+                   plan_.name.c_str(), s_.time, sched_kn0_ * q.scale, m_.kn, scale, m_.dt,
+                   scale > q.scale ? " (raised: a faster grain or body)" : "");
+  }
+  q.scale = scale;
+  q.min_scale = std::min(q.min_scale, scale);
+  q.dt_min = q.dt_min > 0 ? std::min(q.dt_min, m_.dt) : m_.dt;
+  q.dt_max = std::max(q.dt_max, m_.dt);
+}
+
+void Run::schedule_check(bool grains_now) {
+  if (!sched_on_) return;
+  const ScheduleParams& p = m_.schedule;
+  ScheduleState& q = s_.schedule;
+  if (grains_now || s_.step % p.check_every == 0) {  // at fixed steps: a resumed run checks where this one did
+    double v2 = 0;
+    const int n = m_.n_grains;
+    for (int i = 0; i < n; ++i) v2 = std::max(v2, s_.vel[i].squaredNorm());
+    q.v_grains = std::sqrt(v2);
+  }
+  double vb = 0;  // fastest point of a body: |v| + |omega| times its bounding radius
+  for (size_t b = 0; b < s_.bodies.size(); ++b)
+    vb = std::max(vb, s_.bodies[b].vel.norm() + s_.bodies[b].omega.norm() * m_.bodies[b].bound_radius);
+  // Fastest possible approach: two grains head-on, or a grain and a body point.
+  // Speed stored in the deepest contact of the last force pass: a contact at
+  // overlap x holds the energy of an approach at x sqrt(k_n / m*), bounded with
+  // the smallest grain (m* >= m_min / 2).
+  if (grains_now || !(sched_m_min_ > 0)) {
+    sched_m_min_ = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < m_.n_grains; ++i) sched_m_min_ = std::min(sched_m_min_, m_.grain_mass[i]);
+  }
+  const double v_overlap =
+      m_.n_grains > 0 ? s_.stats.max_overlap_ratio * m_.min_radius * std::sqrt(2 * m_.kn / sched_m_min_) : 0.0;
+  // Raised at once for anything faster. Lowered only once the target has
+  // stayed below a quarter of the current factor for three durations of the
+  // longest contact: lowering k_n takes ½ Δk x² out of every live contact, so
+  // it waits until collisions begun at the higher speed are over.
+  const auto target = [&](double v_fast) {
+    const double r = p.margin * v_fast / p.speed;
+    return std::clamp(r * r, p.floor, 1.0);
+  };
+  const double t = target(std::max({2 * q.v_grains, vb + q.v_grains, v_overlap}));
+  // Twice the target on either change.
+  if (t > q.scale) {
+    q.low_since = -1;
+    set_stiffness_scale(std::min(1.0, 2 * t), true);
+  } else if (t < 0.25 * q.scale && s_.time - q.t_start >= p.after) {
+    if (q.low_since < 0) q.low_since = s_.step;
+    if (s_.step - q.low_since >= sched_hold_) {
+      q.low_since = -1;
+      set_stiffness_scale(t <= p.floor ? p.floor : 2 * t, true);
+    }
+  } else {
+    q.low_since = -1;
+  }
 }
 
 void Run::finish() {
@@ -368,6 +487,11 @@ RunReport Run::run() {
     rep_.woke = z.woke;
     rep_.discarded_energy = z.discarded_energy;
     rep_.discarded_max_speed = z.discarded_max_speed;
+  }
+  if (sched_on_) {
+    rep_.schedule = true;
+    rep_.dt_scene = sched_dt0_;
+    rep_.sched = s_.schedule;
   }
   if (!opt_.out_dir.empty()) {
     if (rep_.status == "ok") sample();

@@ -46,6 +46,7 @@ void SceneRun::add_run_and_observers(JsonObject& j, const Model& m, const RunRep
   run.num("wall_seconds", rep.wall_seconds).num("dt", m.dt).num("kn", m.kn);
   if (threads > 0) run.num("threads", threads);
   add_sleep_summary(run, rep);
+  add_schedule_summary(run, rep);
   j.obj("run", run);
   JsonObject obs;
   for (Observer* o : const_cast<SceneRun*>(this)->observers()) o->summary(obs);
@@ -59,6 +60,17 @@ void add_sleep_summary(JsonObject& j, const RunReport& rep) {
   sl.num("fell_asleep", double(rep.fell_asleep)).num("woke", double(rep.woke));
   sl.num("discarded_kinetic_energy", rep.discarded_energy).num("discarded_max_speed", rep.discarded_max_speed);
   j.obj("sleep", sl);
+}
+
+void add_schedule_summary(JsonObject& j, const RunReport& rep) {
+  if (!rep.schedule) return;
+  const ScheduleState& q = rep.sched;
+  JsonObject o;
+  o.num("dt_scene", rep.dt_scene).num("dt_min", q.dt_min).num("dt_max", q.dt_max);
+  o.num("kn_factor_at_end", q.scale).num("kn_factor_min", q.min_scale);
+  o.num("lowered", double(q.lowered)).num("raised", double(q.raised));
+  o.num("injected_energy", q.injected).num("released_energy", q.released).num("max_injected_fraction_of_kinetic", q.max_injected_fraction);
+  j.obj("schedule", o);
 }
 
 double Scene::bed_top() const { return std::numeric_limits<double>::infinity(); }

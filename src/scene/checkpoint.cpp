@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -16,10 +17,10 @@ namespace rt {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'G', 'T', 'W', 'C', 'K', 'P', 'T'};
-// 5: sleep state (docs/model.md §16); 4 (history slots of grain–mesh
-// contacts), 3 (rigid bodies, no grain–mesh contacts) and 2 (grains only)
-// are still read.
-constexpr uint32_t kVersion = 5;
+// 6: ticks and the stiffness schedule's state (docs/model.md §17); 5 (sleep
+// state, docs/model.md §16), 4 (history slots of grain–mesh contacts), 3
+// (rigid bodies, no grain–mesh contacts) and 2 (grains only) are still read.
+constexpr uint32_t kVersion = 6;
 
 // Fingerprint of the static grain description a state belongs to.
 uint64_t model_fingerprint(const Model& m) {
@@ -175,6 +176,17 @@ void save_checkpoint(const std::string& path, const Model& m, const State& s) {
     w.pod(z.discarded_energy);
     w.pod(z.discarded_max_speed);
   }
+  // Ticks and the stiffness schedule (model.md §17).
+  w.pod(s.ticks);
+  w.pod(s.tick_len);
+  const ScheduleState& q = s.schedule;
+  for (double v :
+       {q.scale, q.min_scale, q.dt_min, q.dt_max, q.injected, q.max_injected_fraction, q.t_start, q.v_grains, q.released})
+    w.pod(v);
+  w.pod<int64_t>(q.lowered);
+  w.pod<int64_t>(q.raised);
+  w.pod<uint8_t>(q.started ? 1 : 0);
+  w.pod<int64_t>(q.low_since);
   const uint64_t sum = fnv1a(w.buf.data(), w.buf.size());
   w.pod(sum);
 
@@ -205,7 +217,7 @@ State load_checkpoint(const std::string& path, const Model& m) {
   char magic[8];
   r.raw(magic, 8);
   const uint32_t version = r.pod<uint32_t>();
-  if (version != kVersion && version != 4 && version != 3 && version != 2)
+  if (version != kVersion && version != 5 && version != 4 && version != 3 && version != 2)
     r.fail("format version " + std::to_string(version) + ", this build reads version " + std::to_string(kVersion));
   const uint64_t n = r.pod<uint64_t>();
   if (n != uint64_t(m.n_grains))
@@ -296,6 +308,22 @@ State load_checkpoint(const std::string& path, const Model& m) {
     z.cell_count.assign(cells, 0);
     z.cell_scratch.assign(n, -1);
     z.initialized = true;
+  }
+  s.ticks = double(s.step);
+  if (version >= 6) {
+    s.ticks = r.pod<double>();
+    s.tick_len = r.pod<double>();
+    ScheduleState& q = s.schedule;
+    for (double* v : {&q.scale, &q.min_scale, &q.dt_min, &q.dt_max, &q.injected, &q.max_injected_fraction,
+                      &q.t_start, &q.v_grains, &q.released})
+      *v = r.pod<double>();
+    q.lowered = r.pod<int64_t>();
+    q.raised = r.pod<int64_t>();
+    q.started = r.pod<uint8_t>() != 0;
+    q.low_since = r.pod<int64_t>();
+    if (!std::isfinite(s.ticks) || !(s.tick_len > 0) || !std::isfinite(s.tick_len) || !(q.scale > 0) ||
+        !(q.scale <= 1) || !(q.min_scale > 0) || !(q.min_scale <= q.scale))
+      r.fail("stiffness schedule state is invalid");
   }
   if (r.pos() + 8 != data.size()) r.fail("unexpected trailing data");
   for (int p : s.pairs.partner)

@@ -445,7 +445,7 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   const Reader rd(source);
   if (!root || !root.IsMap()) throw InputError(source + ": expected a YAML mapping at the top level");
   rd.only(root, "",
-          {"name", "seed", "gravity", "contact", "guards", "sleep", "materials", "walls", "bodies", "grains",
+          {"name", "seed", "gravity", "contact", "guards", "sleep", "schedule", "materials", "walls", "bodies", "grains",
            "stages", "output"});
   Scenario sc;
   sc.file = source;
@@ -541,6 +541,17 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   sp.cell = rd.number(sl, "sleep", "cell", sp.cell, 0, kInf);
   sp.check_every = int(rd.integer(sl, "sleep", "check_every", sp.check_every, 1, 1000000));
   sp.at_start = rd.boolean(sl, "sleep", "at_start", sp.at_start);
+
+  // Stiffness schedule (docs/model.md §17).
+  const YAML::Node sh = rd.map(root, "", "schedule", false);
+  rd.only(sh, "schedule", {"enabled", "speed", "margin", "floor", "after", "check_every"});
+  ScheduleParams& q = m.schedule;
+  q.enabled = rd.boolean(sh, "schedule", "enabled", false);
+  q.speed = rd.number(sh, "schedule", "speed", sc.v_ref, 0, 1e5, true);
+  q.margin = rd.number(sh, "schedule", "margin", q.margin, 1, 100);
+  q.floor = rd.number(sh, "schedule", "floor", q.floor, 1e-8, 1);
+  q.after = rd.number(sh, "schedule", "after", q.after, 0, kInf);
+  q.check_every = int(rd.integer(sh, "schedule", "check_every", q.check_every, 1, 1000000));
 
   finalize_model(m);
   sc.scene_kn = m.kn;

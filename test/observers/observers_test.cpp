@@ -57,12 +57,15 @@ TEST(Observers, EjectaCountOnceWithVolumeOnSampledSteps) {
   rt::Ejecta e(0.2, 10);
   e.prepare(l.m, l.s);
   l.s.pos[0].z() = 0.3;
-  l.s.step = 5;  // not a sampled step
+  l.s.step = 5;
+  l.s.ticks = 5;  // not a sampled step
   e.after_step(l.m, l.s);
   EXPECT_EQ(e.count(), 0);
   l.s.step = 10;
+  l.s.ticks = 10;
   e.after_step(l.m, l.s);
   l.s.step = 20;
+  l.s.ticks = 20;
   e.after_step(l.m, l.s);  // still above: counted once
   EXPECT_EQ(e.count(), 1);
   EXPECT_DOUBLE_EQ(e.volume(), 4.0 / 3.0 * M_PI * 1e-6);
@@ -102,6 +105,7 @@ TEST(Observers, ActiveZoneFreezesBeyondTheRadiusAndWakesAsTheBodyComes) {
   }
   l.s.bodies[0].pos.x() = 0.01;  // moved less than 2 cm: no update
   l.s.step = 1;
+  l.s.ticks = 1;
   z.after_step(l.m, l.s);
   EXPECT_EQ(l.m.grain_inv_mass[2], 0);
   l.s.bodies[0].pos.x() = 0.3;  // now grains at 0.2, 0.3, 0.4 are inside; 0 and 0.1 stay woken

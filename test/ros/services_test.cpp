@@ -65,6 +65,14 @@ regolith_twin::Step::Response step(long n) {
   return s.response;
 }
 
+regolith_twin::Step::Response step_for(double seconds, long steps = 0) {
+  regolith_twin::Step s;
+  s.request.duration = seconds;
+  s.request.steps = steps;
+  EXPECT_TRUE(ros::service::call(srv("step"), s));
+  return s.response;
+}
+
 rt::Twin reference_twin() {
   rt::TwinOptions to;
   to.file = g_params.scenario_file;
@@ -101,6 +109,22 @@ TEST(TwinNodeServices, StepAdvancesBySteps_AndBodiesMoveAsTheEngine) {
   EXPECT_EQ(b.twist.linear.z, e.vel.z());
   EXPECT_EQ(b.twist.angular.x, e.omega.x());
   EXPECT_GT(b.contacts, 0u) << "250 steps reach the plate (first contact after about 100)";
+}
+
+TEST(TwinNodeServices, StepAdvancesByADuration) {
+  ASSERT_TRUE(trigger("reset"));
+  ASSERT_TRUE(trigger("pause"));
+  const double t0 = g_node->sim_time(), dt = g_node->dt();
+  // 37.4 steps' worth: the span ends at the step nearest its end (37 steps).
+  const auto r = step_for(37.4 * dt);
+  ASSERT_TRUE(r.success) << r.message;
+  EXPECT_NEAR(r.sim_time, t0 + 37 * dt, 1e-9 * dt);
+  auto bad = step_for(-1.0);
+  EXPECT_FALSE(bad.success);
+  EXPECT_NE(bad.message.find("allowed range"), std::string::npos) << bad.message;
+  bad = step_for(1e-3, 5);
+  EXPECT_FALSE(bad.success);
+  EXPECT_NE(bad.message.find("not both"), std::string::npos) << bad.message;
 }
 
 TEST(TwinNodeServices, StepIsRefusedWhileRunning_AndBadCountsAreRefused) {

@@ -100,6 +100,27 @@ struct SleepParams {
   bool at_start = true;   // cells quiet at the first check fall asleep at once (a relaxed bed)
 };
 
+// Stiffness schedule (docs/model.md §17): the scene's k_n is designed for the
+// largest expected relative speed (contact.v_max). When nothing moves that
+// fast any more, k_n follows the fastest possible approach, v_fast (twice the
+// fastest grain, or the fastest body point plus the fastest grain), by the
+// same rule: target = (margin v_fast / speed)^2 in [floor, 1] of k_scene,
+// and Δt = Δt_scene / sqrt(k_n / k_scene) (the same steps per contact).
+// v_fast also counts the speed stored in the deepest contact, so a contact
+// being compressed keeps k_n up. k_n is set to twice the target when the
+// target passes it (raised at once: the energy this injects into live
+// contacts is measured and reported), or when the target has stayed below a
+// quarter of it for three durations of the longest contact (lowered: the
+// energy taken out of live contacts is reported too).
+struct ScheduleParams {
+  bool enabled = false;
+  double speed = 0;        // design speed of the scene's k_n, m/s (<= 0: contact.v_max)
+  double margin = 1.2;     // on v_fast
+  double floor = 1e-4;     // smallest factor on the scene's k_n (Δt at most 100x the scene's)
+  double after = 0;        // s of simulated time from the run's start before the first lowering
+  int check_every = 10;    // steps between checks of the grains' speeds (bodies: every step)
+};
+
 struct Guards {
   double max_overlap_ratio = 0.25;  // overlap / smaller radius of the pair
   double min_steps_per_contact_warn = 10;
@@ -155,6 +176,7 @@ struct Model {
   int single_grain_material = -1;      // the material of every grain if they share one, else -1
   Guards guards;
   SleepParams sleep;
+  ScheduleParams schedule;
 
   double max_radius = 0, min_radius = 0;  // extreme grain radii, m
 };

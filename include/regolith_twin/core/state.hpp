@@ -5,6 +5,7 @@
 // itself never allocates, except when a neighbour list outgrows its reserve.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -160,9 +161,31 @@ struct SleepState {
   std::vector<uint8_t> touch;      // grains touching a grain, wall or body (checks)
 };
 
+// Stiffness schedule state (model.hpp ScheduleParams, docs/model.md §17).
+struct ScheduleState {
+  double scale = 1;              // current factor on the scene's k_n (Δt = scene Δt / sqrt(scale))
+  double min_scale = 1;          // smallest factor reached
+  double dt_min = 0, dt_max = 0; // smallest and largest Δt taken under the schedule, s (0: none yet)
+  long lowered = 0, raised = 0;  // changes of k_n
+  double injected = 0;           // elastic energy added to live contacts by raising k_n, J
+  double released = 0;           // elastic energy taken from live contacts by lowering k_n, J
+  double max_injected_fraction = 0;  // largest injection relative to the kinetic energy then
+  bool started = false;          // the schedule has run (its base is the scene's k_n and Δt)
+  double t_start = 0;            // simulated time it started, s
+  double v_grains = 0;           // fastest grain at the last check, m/s
+  long low_since = -1;           // step since which the target has stayed low (-1: it has not)
+};
+
 struct State {
   double time = 0;              // simulated time, s
   long step = 0;                // steps taken
+  // Elapsed steps counted in steps of the scene's Δt: each step adds
+  // tick_len (1 unless a stiffness schedule has changed Δt, then Δt / Δt_scene).
+  // Observers that sample every N steps sample when ticks cross a multiple of
+  // N, so their sampling stays fixed in simulated time under a schedule.
+  double ticks = 0;
+  double tick_len = 1;
+  ScheduleState schedule;
 
   std::vector<Vec3> pos;        // grain centre, m (n_grains)
   std::vector<Vec3> vel;        // velocity, m/s
@@ -223,6 +246,13 @@ struct State {
   bool log_contacts = false;  // record every contact of each force pass in scratch[p].log
   bool scalar_kernel = false;  // evaluate contacts one at a time (reference for the batched kernel)
 };
+
+// True when the last step crossed a multiple of `every` ticks counted from
+// `origin` (every step with every = 1; without a schedule: (step - origin) % every == 0).
+inline bool ticks_crossed(const State& s, long every, double origin = 0) {
+  const double a = (s.ticks - origin) / double(every), b = (s.ticks - s.tick_len - origin) / double(every);
+  return std::floor(a) != std::floor(b);
+}
 
 // Sleeping is on and its state initialised (core/sleep.hpp).
 inline bool sleep_active(const Model& m, const State& s) { return m.sleep.enabled && s.sleep.initialized; }

@@ -103,6 +103,7 @@ class TwinNode {
   std::condition_variable step_cv_;  // wakes a step request when its steps are done
   bool paused_ = false;
   long pending_steps_ = 0;
+  double pending_until_ = -1;  // a ~step by duration: simulated time it ends at (-1: by count)
   bool failed_ = false;              // a blow-up stopped the run
   std::string failure_;
   std::atomic<bool> running_{false};

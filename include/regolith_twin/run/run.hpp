@@ -70,6 +70,11 @@ struct RunReport {
   double mean_awake = 0;
   long fell_asleep = 0, woke = 0;
   double discarded_energy = 0, discarded_max_speed = 0;
+  // Stiffness schedule (docs/model.md §17), when on: the scene's Δt and the
+  // schedule's state at the end (factors reached, changes, energy injected).
+  bool schedule = false;
+  double dt_scene = 0;
+  ScheduleState sched;
 };
 
 class Run {
@@ -114,6 +119,12 @@ class Run {
   void end_stage(const char* reason);
   void sample();
   void progress();
+  // Stiffness schedule (docs/model.md §17): its base values at the run's
+  // start, then a check after every step (grain speeds every check_every
+  // steps, or at once when grains were added).
+  void schedule_start();
+  void schedule_check(bool grains_now);
+  void set_stiffness_scale(double scale, bool account);
 
   Model& m_;
   State& s_;
@@ -128,6 +139,10 @@ class Run {
   double t_start_ = 0, t_ramp0_ = 0;
   long step0_ = 0;
   double awake0_ = 0;  // SleepState::awake_grain_steps at the start
+  bool sched_on_ = false;
+  double sched_kn0_ = 0, sched_body_kn0_ = 0, sched_dt0_ = 0;  // the scene's, at the run's start
+  double sched_m_min_ = 0;  // smallest grain mass, kg
+  long sched_hold_ = 1;     // steps the target must stay low before k_n is lowered
   Vec3 g_from_ = Vec3::Zero();
   std::vector<uint8_t> held_, drop_;
   std::vector<int> old_to_new_;

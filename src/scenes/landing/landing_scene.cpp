@@ -194,6 +194,7 @@ void write_landing_summary(const std::string& path, const LandingScene& ls, cons
   run.num("steps", double(o.steps)).num("wall_seconds", o.wall_seconds).num("dt", m.dt).num("kn", m.kn);
   if (threads > 0) run.num("threads", threads);
   if (rep) add_sleep_summary(run, *rep);
+  if (rep) add_schedule_summary(run, *rep);
   j.obj("run", run);
   j.write(path);
 }

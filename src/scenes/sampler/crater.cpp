@@ -101,7 +101,7 @@ void Crater::start(const Model& m, const State& s) {
 }
 
 bool Crater::after_step(Model& m, State& s) {
-  if (s.step % every_ == 0) measure(m, s);
+  if (ticks_crossed(s, every_)) measure(m, s);
   return false;
 }
 

@@ -24,7 +24,7 @@ void HornSegments::count(const Model& m, const State& s) {
 }
 
 bool HornSegments::leaving(const Model& m, const State& s, std::vector<uint8_t>& drop) {
-  if (s.step % every_ != 0) return false;
+  if (!ticks_crossed(s, every_)) return false;
   bool any = false;
   const double top = g_.top(), rt = g_.top_radius();
   for (int i = 0; i < m.n_grains; ++i) {

@@ -68,6 +68,7 @@ void ImpactClock::mark(const State& s) {
   hit_ = true;
   t_impact_ = s.time;
   impact_step_ = s.step;
+  impact_ticks_ = s.ticks;
   impact_pos_ = s.pos[projectile_];
   impact_vel_ = s.vel[projectile_];
 }
@@ -133,7 +134,7 @@ void EjectionAngles::start(const Model& m, const State& s) {
 }
 
 bool EjectionAngles::after_step(Model& m, State& s) {
-  if (!clock_->hit() || (s.step - clock_->impact_step()) % every_ != 0) return false;
+  if (!clock_->hit() || !ticks_crossed(s, every_, clock_->impact_ticks())) return false;
   const int p = clock_->projectile();
   const double t = clock_->after(s);
   for (int i = 0; i < m.n_grains; ++i) {
@@ -264,7 +265,7 @@ bool EnergyPartition::after_step(Model& m, State& s) {
   if (complete_ || !clock_->hit()) return false;
   const double t = clock_->after(s);
   const bool end = reached(m, t, window_);
-  if (!end && (s.step - clock_->impact_step()) % every_ != 0) return false;
+  if (!end && !ticks_crossed(s, every_, clock_->impact_ticks())) return false;
   samples_.push_back(energy_parts(m, s, clock_->projectile()));
   samples_.back().t = t;
   complete_ = end;

@@ -215,6 +215,9 @@ std::unique_ptr<Scene> SamplerKind::prepare(const YAML::Node& doc, const std::st
   if (!root["contact"]) root["contact"] = YAML::Node(YAML::NodeType::Map);
   root["contact"]["kn"] = sp.kn_ref * ratio * ratio;
   root["contact"]["dt"] = sp.dt_ref / ratio * sp.dt_factor;
+  // A stiffness schedule's design speed is the shot's (docs/model.md §17).
+  if (const YAML::Node& sch = static_cast<const YAML::Node&>(root)["schedule"]; sch && sch.IsMap() && !sch["speed"])
+    root["schedule"]["speed"] = sp.speed;
   ss->sc = parse_scenario(root, file);
   Scenario& sc = ss->sc;
   Model& m = sc.model;
@@ -316,6 +319,7 @@ std::unique_ptr<Scene> SamplerKind::prepare(const YAML::Node& doc, const std::st
   s.forces_valid = false;
   s.time = 0;  // shot time counts from firing
   s.step = 0;
+  s.ticks = 0;
   if (!opt.quiet)
     std::fprintf(stderr,
                  "[sampler] bed: %d grains, packing %.3f, bulk %.0f kg/m^3, rest RMS %.3g m/s; horn bottom at "

@@ -221,6 +221,7 @@ void impact_step(Synthetic& y, const std::vector<rt::Observer*>& obs) {
 
 void at(Synthetic& y, long step, double after_impact, const std::vector<rt::Observer*>& obs) {
   y.s.step = step;
+  y.s.ticks = double(step);
   y.s.time = kDt + after_impact;
   for (rt::Observer* o : obs) o->after_step(y.m, y.s);
 }

@@ -36,6 +36,7 @@ class ImpactClock : public Observer {
   bool hit() const { return hit_; }
   double t_impact() const { return t_impact_; }      // s (run time), NaN before the impact
   long impact_step() const { return impact_step_; }  // -1 before the impact
+  double impact_ticks() const { return impact_ticks_; }  // State::ticks at the impact
   int projectile() const { return projectile_; }     // current index; -1 once it left the run
   // Projectile centre and velocity at the impact step.
   const Vec3& impact_position() const { return impact_pos_; }
@@ -50,6 +51,7 @@ class ImpactClock : public Observer {
   bool hit_ = false;
   double t_impact_;
   long impact_step_ = -1;
+  double impact_ticks_ = 0;
   Vec3 impact_pos_ = Vec3::Zero(), impact_vel_ = Vec3::Zero();
   // Pair-list entries holding the projectile, valid for one list build.
   std::vector<int> entries_;

@@ -1,0 +1,231 @@
+// Stiffness schedule (docs/model.md §17): a bouncing grain keeps the
+// restitution of the linear law (independent of k_n) while k_n and Δt follow
+// its speed, in fewer steps; a fast grain appearing raises k_n at once and
+// the energy this injects into a resting contact is ½ Δk x²; a run resumed
+// from a checkpoint under a lowered k_n continues bit for bit; observers
+// sampling every N steps keep their period in simulated time.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "regolith_twin/run/run.hpp"
+#include "regolith_twin/scene/checkpoint.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+// One grain of 1 cm radius bouncing between two walls 4 cm apart without
+// gravity, starting at 2 m/s; k_n by the rule for 4 m/s with 1 % overlap,
+// 100 steps per contact (the restitution of a discrete contact depends on
+// where in a step it starts: a few 0.1 % at 100 steps).
+std::string bounce_yaml(bool schedule) {
+  return std::string(R"(
+name: bounce
+gravity: [0, 0, 0]
+materials:
+  grain: {preset: moderate, eps_n: 0.5, eps_t: 1.0, mu_s: 0.0}
+  wall: {preset: moderate, eps_n: 0.5, eps_t: 1.0, mu_s: 0.0, structure: true}
+contact: {model: linear, kn: rule, v_max: 4.0, x_max: 0.01, steps_per_contact: 100}
+walls:
+  - {type: plane, point: [-0.02, 0, 0], normal: [1, 0, 0], material: wall}
+  - {type: plane, point: [0.02, 0, 0], normal: [-1, 0, 0], material: wall}
+grains:
+  - {name: ball, material: grain, radius: 0.01, position: [-0.001, 0, 0], velocity: [2.0, 0, 0]}
+stages:
+  - {name: bounce, duration: 5.0}
+)") + "schedule: {enabled: " + (schedule ? "true" : "false") + "}\n";
+}
+
+// Records the grain's speed each time it crosses the middle (in free flight)
+// and ends the run at the crossing after `bounces` bounces.
+class Crossings : public rt::Observer {
+ public:
+  explicit Crossings(int bounces) : want_(bounces + 1) {}
+  bool after_step(rt::Model& m, rt::State& s) override {
+    const double x = s.pos[0].x();
+    if ((x_ < 0) != (x < 0)) speed.push_back(std::fabs(s.vel[0].x()));
+    x_ = x;
+    return int(speed.size()) >= want_;
+  }
+  std::vector<double> speed;
+
+ private:
+  int want_;
+  double x_ = -1;
+};
+
+rt::RunOptions quiet() {
+  rt::RunOptions o;
+  o.progress_every = 0;
+  return o;
+}
+
+struct Bounces {
+  std::vector<double> speed;  // at each crossing of the middle, m/s
+  long steps = 0;
+  rt::ScheduleState sched;
+};
+
+Bounces bounce(bool schedule) {
+  rt::Scenario sc = rt::parse_scenario_text(bounce_yaml(schedule));
+  rt::State s = sc.initial;
+  rt::Run run(sc.model, s, rt::RunPlan::of(sc), quiet());
+  Crossings c(4);
+  run.add_observer(&c);
+  const rt::RunReport rep = run.run();
+  EXPECT_EQ(rep.status, "ok") << rep.message;
+  EXPECT_EQ(rep.schedule, schedule);
+  return {c.speed, rep.steps, s.schedule};
+}
+
+}  // namespace
+
+TEST(Schedule, BouncesKeepTheirRestitutionInFewerSteps) {
+  const Bounces ref = bounce(false), sch = bounce(true);
+  ASSERT_EQ(ref.speed.size(), 5u);
+  ASSERT_EQ(sch.speed.size(), 5u);
+  EXPECT_EQ(ref.speed[0], 2.0);
+  EXPECT_EQ(sch.speed[0], 2.0);
+  // Linear law: each bounce returns e = 0.5 of the speed, for any k_n.
+  for (int k = 1; k < 5; ++k) {
+    EXPECT_NEAR(ref.speed[k] / ref.speed[k - 1], 0.5, 0.005) << "fixed k_n, bounce " << k;
+    EXPECT_NEAR(sch.speed[k] / sch.speed[k - 1], 0.5, 0.005) << "scheduled k_n, bounce " << k;
+  }
+  RecordProperty("speed4_fixed", rt::test::figure(ref.speed[4]));
+  RecordProperty("speed4_scheduled", rt::test::figure(sch.speed[4]));
+  RecordProperty("steps_fixed", rt::test::figure(double(ref.steps)));
+  RecordProperty("steps_scheduled", rt::test::figure(double(sch.steps)));
+  // Lowered after each bounce (never raised: nothing gets faster), down to
+  // twice the target of the last speed, 0.125 m/s: 2 (1.2 x 2 x 0.125 / 4)^2.
+  EXPECT_GE(sch.sched.lowered, 3);
+  EXPECT_EQ(sch.sched.raised, 0);
+  EXPECT_NEAR(sch.sched.scale, 2 * std::pow(1.2 * 2 * sch.speed[4] / 4, 2), 1e-9);
+  EXPECT_LT(sch.steps, ref.steps / 2) << "scheduled " << sch.steps << " steps, fixed " << ref.steps;
+}
+
+namespace {
+
+// Grain 1, parked high, is given 4 m/s straight down at time t_go; the
+// overlap of grain 0 (resting on the floor) just before is recorded.
+class Throw : public rt::Observer {
+ public:
+  explicit Throw(double t_go) : t_go_(t_go) {}
+  bool after_step(rt::Model& m, rt::State& s) override {
+    if (!thrown && s.time >= t_go_) {
+      thrown = true;
+      overlap = m.grain_radius[0] - s.pos[0].z();
+      kn_before = m.kn;
+      s.vel[1] = rt::Vec3(0, 0, -4.0);
+    }
+    return thrown && s.time > t_go_ + 0.2;
+  }
+  bool thrown = false;
+  double overlap = 0, kn_before = 0;
+
+ private:
+  double t_go_;
+};
+
+}  // namespace
+
+TEST(Schedule, AFastGrainRaisesStiffnessAndTheInjectionIsMeasured) {
+  // Grain 0 rests on the floor; grain 1 is held 5 cm above it until thrown
+  // down at 4 m/s (the design speed): both slow before, so k_n sits at the floor.
+  const std::string yaml = R"(
+name: throw
+gravity: [0, 0, -9.81]
+materials:
+  grain: {preset: moderate, eps_n: 0.5, eps_t: 1.0, mu_s: 0.0}
+  wall: {preset: moderate, eps_n: 0.5, eps_t: 1.0, mu_s: 0.0, structure: true}
+contact: {model: linear, kn: rule, v_max: 4.0, x_max: 0.01, steps_per_contact: 30}
+walls:
+  - {type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: wall}
+grains:
+  - {name: rest, material: grain, radius: 0.01, position: [0, 0, 0.01]}
+  - {name: fly, material: grain, radius: 0.01, position: [0, 0, 0.08]}
+stages:
+  - {name: wait, duration: 0.1, hold: [fly]}
+  - {name: go, duration: 0.03}
+schedule: {enabled: true, floor: 1.0e-3}
+)";
+  rt::Scenario sc = rt::parse_scenario_text(yaml);
+  const double kn_scene = sc.model.kn;
+  rt::State s = sc.initial;
+  rt::Run run(sc.model, s, rt::RunPlan::of(sc), quiet());
+  Throw t(0.1);
+  run.add_observer(&t);
+  const rt::RunReport rep = run.run();
+  ASSERT_EQ(rep.status, "ok") << rep.message;
+  ASSERT_TRUE(t.thrown);
+  const rt::ScheduleState& q = s.schedule;
+  EXPECT_EQ(q.min_scale, 1.0e-3);
+  EXPECT_EQ(q.raised, 1) << "the throw's check raises k_n to the scene's value (1.2 x 2 x 4 m/s > 4 m/s)";
+  const double k0 = t.kn_before, x = t.overlap;
+  ASSERT_EQ(k0, 1.0e-3 * kn_scene);
+  // Grain 0 rests at x = m g / k0.
+  EXPECT_NEAR(x, sc.model.grain_mass[0] * 9.81 / k0, 1e-3 * x);
+  // Energy injected into the resting contact: ½ (k1 - k0) x² (frictionless:
+  // no tangential spring).
+  const double expect = 0.5 * (kn_scene - k0) * x * x;
+  RecordProperty("injected_J", rt::test::figure(q.injected));
+  RecordProperty("half_dk_x2_J", rt::test::figure(expect));
+  EXPECT_NEAR(q.injected / expect, 1.0, 0.01);
+  // Grain 1 hits grain 0 at about 4 m/s: resolved at the scene's stiffness,
+  // the overlap stays near the design 1 % of the radius.
+  EXPECT_LT(rep.max_overlap_ratio, 0.02);
+}
+
+TEST(Schedule, ResumeUnderALoweredStiffnessIsBitIdentical) {
+  const std::string path = "/tmp/regolith_schedule_" + std::to_string(::getpid()) + ".ckpt";
+  // Runs on until `stop`; returns the model as the run left it.
+  auto run_until = [](rt::Model m, rt::State& s, auto stop) {
+    rt::Run run(m, s, rt::RunPlan::open_ended("bounce"), quiet());
+    while (!stop(s) && run.advance()) {
+    }
+    return m;
+  };
+  rt::Scenario sc = rt::parse_scenario_text(bounce_yaml(true));
+  rt::State part = sc.initial;
+  const rt::Model mid = run_until(sc.model, part, [](const rt::State& s) { return s.schedule.lowered >= 2; });
+  ASSERT_LT(part.schedule.scale, 1.0) << "the checkpoint is taken under a lowered k_n";
+  const long end = part.step + 50000;
+  rt::State whole = sc.initial;
+  run_until(sc.model, whole, [end](const rt::State& s) { return s.step >= end; });
+  rt::save_checkpoint(path, mid, part);
+  rt::State resumed = rt::load_checkpoint(path, sc.model);
+  std::remove(path.c_str());
+  EXPECT_EQ(resumed.schedule.scale, part.schedule.scale);
+  EXPECT_EQ(resumed.ticks, part.ticks);
+  run_until(sc.model, resumed, [end](const rt::State& s) { return s.step >= end; });
+  EXPECT_GT(whole.schedule.lowered, part.schedule.lowered) << "k_n changes after the resume point too";
+  EXPECT_EQ(resumed.pos[0], whole.pos[0]);
+  EXPECT_EQ(resumed.vel[0], whole.vel[0]);
+  EXPECT_EQ(resumed.time, whole.time);
+  EXPECT_EQ(resumed.ticks, whole.ticks);
+  EXPECT_EQ(resumed.schedule.scale, whole.schedule.scale);
+  EXPECT_EQ(resumed.schedule.lowered, whole.schedule.lowered);
+  EXPECT_EQ(resumed.schedule.released, whole.schedule.released);
+}
+
+TEST(Schedule, EveryNStepsKeepsItsPeriodInSimulatedTime) {
+  rt::State s;
+  // Without a schedule: every step is one tick; a multiple of 10 is crossed
+  // exactly when (step - origin) % 10 == 0.
+  for (long k = 1; k <= 100; ++k) {
+    s.ticks = double(k);
+    EXPECT_EQ(rt::ticks_crossed(s, 10), k % 10 == 0) << k;
+    EXPECT_EQ(rt::ticks_crossed(s, 10, 3), (k - 3) % 10 == 0) << k;
+  }
+  // Steps of 2.5 scene steps: one sample every 4 steps.
+  s.ticks = 0;
+  s.tick_len = 2.5;
+  int samples = 0;
+  for (int k = 0; k < 40; ++k) {
+    s.ticks += s.tick_len;
+    samples += rt::ticks_crossed(s, 10);
+  }
+  EXPECT_EQ(samples, 10);
+}

@@ -340,8 +340,8 @@ void Run::progress() {
     text += b;
   }
   if (sched_on_) {
-    char b[64];
-    std::snprintf(b, sizeof b, "  dt %.3g s", m_.dt);
+    char b[128];
+    std::snprintf(b, sizeof b, "  dt %.3g s (v_fast %.3g m/s: %s)", m_.dt, sched_vfast_, sched_why_);
     text += b;
   }
   std::fprintf(stderr, "%s%s  %.3g steps/s  %.3g grain-steps/s  %s\n", head, text.c_str(), steps_s,
@@ -443,7 +443,10 @@ void Run::schedule_check(bool grains_now) {
     const double r = p.margin * v_fast / p.speed;
     return std::clamp(r * r, p.floor, 1.0);
   };
-  const double t = target(std::max({2 * q.v_grains, vb + q.v_grains, v_overlap}));
+  const double v_grains = 2 * q.v_grains, v_body = vb + q.v_grains;
+  sched_vfast_ = std::max({v_grains, v_body, v_overlap});
+  sched_why_ = sched_vfast_ == v_overlap ? "a loaded contact" : sched_vfast_ == v_body ? "a body" : "grains";
+  const double t = target(sched_vfast_);
   // Twice the target on either change.
   if (t > q.scale) {
     q.low_since = -1;

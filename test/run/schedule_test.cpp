@@ -63,6 +63,15 @@ rt::RunOptions quiet() {
   return o;
 }
 
+// The scenario's stages run to the end with one observer; s is the state.
+rt::RunReport run_with(rt::Scenario& sc, rt::State& s, rt::Observer& o) {
+  rt::Run run(sc.model, s, rt::RunPlan::of(sc), quiet());
+  run.add_observer(&o);
+  const rt::RunReport rep = run.run();
+  EXPECT_EQ(rep.status, "ok") << rep.message;
+  return rep;
+}
+
 struct Bounces {
   std::vector<double> speed;  // at each crossing of the middle, m/s
   long steps = 0;
@@ -72,11 +81,8 @@ struct Bounces {
 Bounces bounce(bool schedule) {
   rt::Scenario sc = rt::parse_scenario_text(bounce_yaml(schedule));
   rt::State s = sc.initial;
-  rt::Run run(sc.model, s, rt::RunPlan::of(sc), quiet());
   Crossings c(4);
-  run.add_observer(&c);
-  const rt::RunReport rep = run.run();
-  EXPECT_EQ(rep.status, "ok") << rep.message;
+  const rt::RunReport rep = run_with(sc, s, c);
   EXPECT_EQ(rep.schedule, schedule);
   return {c.speed, rep.steps, s.schedule};
 }
@@ -154,11 +160,8 @@ schedule: {enabled: true, floor: 1.0e-3}
   rt::Scenario sc = rt::parse_scenario_text(yaml);
   const double kn_scene = sc.model.kn;
   rt::State s = sc.initial;
-  rt::Run run(sc.model, s, rt::RunPlan::of(sc), quiet());
   Throw t(0.1);
-  run.add_observer(&t);
-  const rt::RunReport rep = run.run();
-  ASSERT_EQ(rep.status, "ok") << rep.message;
+  const rt::RunReport rep = run_with(sc, s, t);
   ASSERT_TRUE(t.thrown);
   const rt::ScheduleState& q = s.schedule;
   EXPECT_EQ(q.min_scale, 1.0e-3);

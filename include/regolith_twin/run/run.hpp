@@ -143,6 +143,8 @@ class Run {
   double sched_kn0_ = 0, sched_body_kn0_ = 0, sched_dt0_ = 0;  // the scene's, at the run's start
   double sched_m_min_ = 0;  // smallest grain mass, kg
   long sched_hold_ = 1;     // steps the target must stay low before k_n is lowered
+  double sched_vfast_ = 0;  // v_fast at the last check, m/s, and what set it (progress line)
+  const char* sched_why_ = "";
   Vec3 g_from_ = Vec3::Zero();
   std::vector<uint8_t> held_, drop_;
   std::vector<int> old_to_new_;

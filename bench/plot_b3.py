@@ -1,0 +1,55 @@
+#!/usr/bin/python3
+"""Sampler shot with the stiffness schedule against the shot with every saving
+off, one bed: horn-segment counts, crater depth and ejected grains over time
+(docs/benchmarks.md, B3). Prints the values at the given times.
+
+    bench/plot_b3.py REF_DIR SCHEDULE_DIR OUT.png [T ...]
+"""
+import csv
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def series(d):
+    rows = list(csv.DictReader(open(d + "/series.csv")))
+    return {k: [float(r[k]) for r in rows] for k in rows[0]}
+
+
+def at(s, key, t):
+    i = min(range(len(s["t"])), key=lambda k: abs(s["t"][k] - t))
+    return s[key][i]
+
+
+ref, sch = series(sys.argv[1]), series(sys.argv[2])
+out = sys.argv[3]
+times = [float(x) for x in sys.argv[4:]] or [0.05, 0.1, 0.2]
+t_end = min(ref["t"][-1], sch["t"][-1])
+fig, ax = plt.subplots(1, 3, figsize=(13, 3.8))
+for k, c in zip(range(1, 4), ["C0", "C1", "C2"]):
+    ax[0].plot(ref["t"], ref[f"seg{k}_n"], c, label=f"segment {k}, all off")
+    ax[0].plot(sch["t"], sch[f"seg{k}_n"], c + "--", label=f"segment {k}, schedule")
+ax[0].set_ylabel("grains in the horn segment")
+ax[1].plot(ref["t"], [1e3 * v for v in ref["crater_depth"]], "k", label="all off")
+ax[1].plot(sch["t"], [1e3 * v for v in sch["crater_depth"]], "r--", label="schedule")
+ax[1].set_ylabel("crater depth (mm)")
+ax[2].plot(ref["t"], ref["ejected_grains"], "k", label="all off")
+ax[2].plot(sch["t"], sch["ejected_grains"], "r--", label="schedule")
+ax[2].set_ylabel("ejected grains")
+for a in ax:
+    a.set_xlim(0, t_end)
+    a.set_xlabel("time after firing (s)")
+    a.legend(fontsize=7)
+fig.suptitle("Sampler shot, 300 m/s: stiffness schedule against everything off (one bed)")
+fig.tight_layout()
+fig.savefig(out, dpi=110)
+for t in times:
+    if t > t_end + 1e-9:
+        continue
+    segs = lambda s: "/".join(str(int(at(s, f"seg{k}_n", t))) for k in range(1, 6))
+    print(f"t = {t:g} s: horn segments {segs(ref)} (off) vs {segs(sch)} (schedule); "
+          f"crater depth {1e3 * at(ref, 'crater_depth', t):.0f} vs {1e3 * at(sch, 'crater_depth', t):.0f} mm; "
+          f"ejected {at(ref, 'ejected_grains', t):.0f} vs {at(sch, 'ejected_grains', t):.0f}")

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,8 @@ void usage(std::FILE* f, const char* tool) {
                "  --out DIR       results (summary.json, series.csv and the scene's own files; default out/<name>)\n"
                "  --threads N     OpenMP threads (default: all cores)\n"
                "  --set k=v       override a key, e.g. --set contact.steps_per_contact=60 or --set landing.angle_deg=60\n"
+               "  --profile P     named settings applied before any --set: profiles/P.yaml beside the scene file,\n"
+               "                  or a file path (e.g. --profile preview: faster, less accurate; docs/benchmarks.md B5)\n"
                "  --cache DIR     where relaxed beds are kept (default $REGOLITH_CACHE or ~/.cache/regolith_twin)\n"
                "  --snapshot F    also write the final grains as a compact bed snapshot F (float32)\n"
                "  --snapshot-precision 32|64  positions of the snapshot in float32 (default) or float64 (stiff beds)\n"
@@ -38,7 +41,7 @@ void usage(std::FILE* f, const char* tool) {
 }
 
 struct Args {
-  std::string file, out, cache, snapshot, checkpoint;
+  std::string file, out, cache, snapshot, checkpoint, profile;
   std::vector<std::string> overrides;
   int threads = 0;
   bool quiet = false, stage_snapshots = false;
@@ -59,13 +62,14 @@ int parse(int argc, char** argv, const char* tool, Args& a) {
     };
     std::string v;
     if (o == "--out" || o == "--cache" || o == "--snapshot" || o == "--checkpoint" || o == "--set" ||
-        o == "--threads" || o == "--snapshot-precision") {
+        o == "--threads" || o == "--snapshot-precision" || o == "--profile") {
       if (!value(v)) return 2;
       if (o == "--out") a.out = v;
       else if (o == "--cache") a.cache = v;
       else if (o == "--snapshot") a.snapshot = v;
       else if (o == "--checkpoint") a.checkpoint = v;
       else if (o == "--set") a.overrides.push_back(v);
+      else if (o == "--profile") a.profile = v;
       else if (o == "--snapshot-precision") {
         if (v != "32" && v != "64") {
           std::fprintf(stderr, "%s: --snapshot-precision '%s': expected 32 or 64\n", tool, v.c_str());
@@ -106,6 +110,31 @@ int parse(int argc, char** argv, const char* tool, Args& a) {
   return -1;
 }
 
+// A profile is a YAML map of dotted keys to values (config/profiles/*.yaml),
+// turned into --set overrides that come before the command line's own.
+std::vector<std::string> profile_overrides(const std::string& name, const std::string& scene_file) {
+  std::string path = name;
+  if (name.find('/') == std::string::npos && name.find(".yaml") == std::string::npos) {
+    const std::size_t slash = scene_file.rfind('/');
+    path = (slash == std::string::npos ? std::string() : scene_file.substr(0, slash + 1)) + "profiles/" + name +
+           ".yaml";
+  }
+  YAML::Node doc;
+  try {
+    doc = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw InputError("--profile " + name + ": cannot read " + path + ": " + e.msg);
+  }
+  if (!doc.IsMap()) throw InputError(path + ": a profile is a map of keys to values (e.g. sleep.enabled: true)");
+  std::vector<std::string> out;
+  for (const auto& kv : doc) {
+    if (!kv.second.IsScalar())
+      throw InputError(path + ": " + kv.first.as<std::string>() + ": expected a single value");
+    out.push_back(kv.first.as<std::string>() + "=" + kv.second.as<std::string>());
+  }
+  return out;
+}
+
 }  // namespace
 
 int run_cli(int argc, char** argv, const char* tool) {
@@ -118,6 +147,11 @@ int run_cli(int argc, char** argv, const char* tool) {
   const int threads = 1;
 #endif
   try {
+    if (!a.profile.empty()) {
+      std::vector<std::string> o = profile_overrides(a.profile, a.file);
+      o.insert(o.end(), a.overrides.begin(), a.overrides.end());
+      a.overrides = std::move(o);
+    }
     if (a.out.empty()) a.out = "out/" + load_document(a.file, a.overrides)["name"].as<std::string>("scenario");
     make_dirs(a.out);
     SceneOptions so;

@@ -78,6 +78,8 @@ bool Run::settle() {
     t0_ = last_progress_ = Clock::now();
     t_start_ = s_.time;
     step0_ = s_.step;
+    rebuilds0_ = s_.rebuilds;
+    body_rebuilds0_ = s_.body_rebuilds;
     awake0_ = s_.sleep.awake_grain_steps;
     next_sample_ = s_.time;
     for (Observer* o : obs_) o->prepare(m_, s_);
@@ -480,6 +482,8 @@ RunReport Run::run() {
   finish();
   rep_.wall_seconds = std::chrono::duration<double>(Clock::now() - t0_).count();
   rep_.steps = s_.step - step0_;
+  rep_.rebuilds = s_.rebuilds - rebuilds0_;
+  rep_.body_rebuilds = s_.body_rebuilds - body_rebuilds0_;
   rep_.sim_time = s_.time;
   if (sleep_active(m_, s_)) {
     const SleepState& z = s_.sleep;

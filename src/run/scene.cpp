@@ -44,6 +44,7 @@ void SceneRun::add_run_and_observers(JsonObject& j, const Model& m, const RunRep
   JsonObject run;
   run.num("grains", m.n_grains).num("steps", double(rep.steps)).num("sim_time", rep.sim_time);
   run.num("wall_seconds", rep.wall_seconds).num("dt", m.dt).num("kn", m.kn);
+  run.num("rebuilds", double(rep.rebuilds)).num("body_rebuilds", double(rep.body_rebuilds));
   if (threads > 0) run.num("threads", threads);
   add_sleep_summary(run, rep);
   add_schedule_summary(run, rep);

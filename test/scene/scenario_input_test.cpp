@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "regolith_twin/run/series.hpp"
 #include "regolith_twin/scenes/scenario/scenario_scene.hpp"
 #include "regolith_twin/scene/scenario.hpp"
 #include "test_support.hpp"
@@ -441,6 +442,33 @@ TEST_F(ScenarioInput, CommandLineToolReportsBadInputWithExitCode2) {
   EXPECT_NE(out.find("no_such_file.yaml"), std::string::npos) << out;
   EXPECT_EQ(run_command("'" + sim + "' '" + bad + "' --threads zero", &out), 2) << out;
   EXPECT_NE(out.find("--threads"), std::string::npos) << out;
+}
+
+TEST_F(ScenarioInput, ProfileKeysComeBeforeTheCommandLinesOwn) {
+  // --profile NAME reads profiles/NAME.yaml beside the scene file; its keys
+  // act as --set overrides placed before the command line's own.
+  const std::string sim = sim_path();
+  ASSERT_EQ(access(sim.c_str(), X_OK), 0) << sim << " not found";
+  const std::string scene = write("cli_profile.yaml", replaced(kBase, "duration: 0.2", "duration: 0.002"));
+  rt::make_dirs(dir_ + "/profiles");
+  write("profiles/fine.yaml", "# a test profile\ncontact.steps_per_contact: 60\n");
+  write("profiles/bad.yaml", "contact: {steps_per_contact: 60}\n");
+  auto dt_of = [&](const std::string& args, const std::string& out_name) {
+    std::string out;
+    const std::string out_dir = dir_ + "/" + out_name;
+    EXPECT_EQ(run_command("'" + sim + "' '" + scene + "' --quiet --threads 1 --out '" + out_dir + "' " + args, &out), 0)
+        << out;
+    return JsonReader(slurp(out_dir + "/summary.json")).document()["dt"].num;
+  };
+  const double dt30 = dt_of("", "p30");
+  EXPECT_NEAR(dt_of("--profile fine", "p60") / dt30, 0.5, 1e-9);
+  EXPECT_NEAR(dt_of("--profile fine --set contact.steps_per_contact=90", "p90") / dt30, 1.0 / 3.0, 1e-9);
+  EXPECT_NEAR(dt_of("--set contact.steps_per_contact=90 --profile fine", "p90b") / dt30, 1.0 / 3.0, 1e-9);
+  std::string out;
+  EXPECT_EQ(run_command("'" + sim + "' '" + scene + "' --quiet --profile no_such_profile", &out), 2) << out;
+  EXPECT_NE(out.find("profiles/no_such_profile.yaml"), std::string::npos) << out;
+  EXPECT_EQ(run_command("'" + sim + "' '" + scene + "' --quiet --profile bad", &out), 2) << out;
+  EXPECT_NE(out.find("expected a single value"), std::string::npos) << out;
 }
 
 TEST_F(ScenarioInput, CommandLineToolReportsBlowUpWithExitCode3) {

@@ -58,6 +58,8 @@ struct RunReport {
   std::string status = "ok";  // ok | blow_up
   std::string message;        // diagnostic when not ok
   long steps = 0;             // taken by this run
+  long rebuilds = 0;          // neighbour-list rebuilds in this run (grain lists; body lists apart)
+  long body_rebuilds = 0;
   double sim_time = 0;        // s at the end
   double wall_seconds = 0;
   double max_overlap_ratio = 0;
@@ -138,6 +140,7 @@ class Run {
   double t_stage_end_ = 0, next_sample_ = 0, next_check_ = 0, next_quench_ = 0;
   double t_start_ = 0, t_ramp0_ = 0;
   long step0_ = 0;
+  long rebuilds0_ = 0, body_rebuilds0_ = 0;
   double awake0_ = 0;  // SleepState::awake_grain_steps at the start
   bool sched_on_ = false;
   double sched_kn0_ = 0, sched_body_kn0_ = 0, sched_dt0_ = 0;  // the scene's, at the run's start

@@ -53,6 +53,10 @@ def main():
                      f"{mean([ref[r]['run']['wall_seconds'] for r in pairs]) / mean([runs[r]['run']['wall_seconds'] for r in pairs]):.1f}x); "
                      f"real-time factor {mean([sim_time(runs[r]) / runs[r]['run']['wall_seconds'] for r in pairs]):.2f}.")
         lines.append("")
+        allv = {k: [runs[r]["outcome"][k] for r in sorted(runs)] for k, *_ in OUTPUTS}
+        lines.append(f"All {len(runs)} beds of {st}: " + "; ".join(
+            f"{lab} {mean(allv[k]):.3g} ± {sd(allv[k]):.2g} (SD)" for k, lab, *_ in OUTPUTS) + ".")
+        lines.append("")
         lines.append("| output | reference | setting | mean difference | 95 % CI | margin | within |")
         lines.append("|---|---|---|---|---|---|---|")
         for k, lab, margin, rel in OUTPUTS:
@@ -65,10 +69,10 @@ def main():
             m = mean(d)
             half = T95.get(len(d) - 1, 1.96) * sd(d) / math.sqrt(len(d)) if len(d) > 1 else float("inf")
             ok = abs(m) + half <= margin
-            unit = " (relative)" if rel else ""
+            unit = ", difference relative" if rel else ""
             lines.append(f"| {lab}{unit} | {' / '.join(f'{x:.3g}' for x in a)} | {' / '.join(f'{y:.3g}' for y in b)} | "
                          f"{m:+.3g} | [{m - half:+.3g}, {m + half:+.3g}] | ±{margin:g} | {'yes' if ok else 'no'} |")
-            plot.setdefault(lab, []).append((st, mean([runs[r]['run']['wall_seconds'] for r in pairs]), m, half, margin))
+            plot.setdefault(lab + unit, []).append((st, mean([runs[r]['run']['wall_seconds'] for r in pairs]), m, half, margin))
         lines.append("")
     print("\n".join(lines))
     draw(plot, mean([ref[r]["run"]["wall_seconds"] for r in ref]) if ref else None)

@@ -40,7 +40,8 @@ def main():
     lines = []
     vals = {k: [ref[r]["outcome"][k] for r in sorted(ref)] for k, *_ in OUTPUTS}
     lines.append(f"Reference (the default scene), {len(ref)} beds (repeats {sorted(ref)}): " + "; ".join(
-        f"{lab} {mean(vals[k]):.3g} ± {sd(vals[k]):.2g} (SD)" for k, lab, *_ in OUTPUTS) + ".")
+        f"{lab} {mean(vals[k]):.3g}" + (f" ± {sd(vals[k]):.2g} (SD)" if len(ref) > 1 else "")
+        for k, lab, *_ in OUTPUTS) + ".")
     lines.append("")
     plot = {}
     for st in settings:
@@ -106,7 +107,7 @@ def mean(x):
 
 def sd(x):
     if len(x) < 2:
-        return float("nan")
+        return float("inf")
     m = mean(x)
     return math.sqrt(sum((v - m) ** 2 for v in x) / (len(x) - 1))
 

@@ -6,14 +6,15 @@
 # finished run's summary.json is copied there (small, kept in git).
 #
 #   bench/b4_landing.sh SETTING FIRST LAST [THREADS]     e.g. bench/b4_landing.sh ref 1 7
-#   settings: ref (the default scene), preview (config/profiles/preview.yaml)
+#   settings: ref (the default scene), or a profile of config/profiles/: preview,
+#   coarse2, preview_coarse2
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BIN=${BIN:-$ROOT/build/devel/lib/regolith_twin}
 setting=${1:?setting}; first=${2:?first repeat}; last=${3:?last repeat}; threads=${4:-2}
 case $setting in
   ref) args=() ;;
-  preview) args=(--profile preview) ;;
+  preview|coarse2|preview_coarse2) args=(--profile "$setting") ;;
   *) echo "b4_landing: unknown setting '$setting'" >&2; exit 2 ;;
 esac
 keep=$ROOT/docs/bench/b4

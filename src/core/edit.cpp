@@ -132,6 +132,17 @@ void request_rebuild(State& s) {
   s.forces_valid = false;
 }
 
+// Free flight (model.md §18): reaches no longer hold once grains are added,
+// removed or moved by hand; the grains that had one count with the others
+// until the next build computes them again.
+void drop_reach(State& s) {
+  s.reach.clear();
+  s.free_grains = 0;
+  s.stats.max_disp2 = std::max(s.stats.max_disp2, s.stats.max_free_disp2);
+  s.stats.max_free_disp2 = 0;
+  s.stats.free_margin = 1e300;
+}
+
 }  // namespace
 
 int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vector<int>* old_to_new) {
@@ -192,6 +203,7 @@ int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vec
   compact_body_grains(s.body_grains, map);
   if (s.lists_valid) partition_work(m, s);
   partition_body_list(m, s);
+  drop_reach(s);
   request_rebuild(s);
   return n - kept;
 }
@@ -233,6 +245,7 @@ int add_grain(Model& m, State& s, double radius, int material, const Vec3& pos, 
   } else {
     s.lists_valid = false;
   }
+  drop_reach(s);
   request_rebuild(s);
   return i;
 }
@@ -250,6 +263,7 @@ void rotate_grains_about_z(const Model& m, State& s, double angle) {
     s.torque[i] = R * s.torque[i];
     s.pos_at_build[i] = R * s.pos_at_build[i];
   }
+  drop_reach(s);
   for (auto* l : {&s.pairs.spring_t, &s.pairs.spring_r, &s.wall_pairs.spring_t, &s.wall_pairs.spring_r})
     for (Vec3& v : *l) v = R * v;
   // The sleep cells do not turn with the bed: sleeping starts again, every grain awake.

@@ -27,12 +27,17 @@ void kick_drift(const Model& m, State& s, double h, double dt) {
   Vec3* __restrict omega_mid = s.omega_mid.data();
   bool finite = true;
   double max_d2 = s.stats.max_disp2;
+  // Free flight (model.md §18): grains with a reach are measured apart.
+  const bool free = !s.reach.empty();
+  const double* __restrict reach = s.reach.data();
+  double max_f2 = s.stats.max_free_disp2, margin = s.stats.free_margin;
   // With sleeping, only the awake grains (ascending ids); sleeping grains
   // keep zero velocities and do not move (model.md §16).
   const bool sleeping = sleep_active(m, s);
   const int* __restrict awake = s.sleep.awake.data();
   const int count = sleeping ? int(s.sleep.awake.size()) : n;
-#pragma omp parallel for schedule(static) reduction(&& : finite) reduction(max : max_d2) if (n >= m.parallel_min_grains)
+#pragma omp parallel for schedule(static) reduction(&& : finite) reduction(max : max_d2, max_f2) \
+    reduction(min : margin) if (n >= m.parallel_min_grains)
   for (int q = 0; q < count; ++q) {
     const int i = sleeping ? awake[q] : q;
     const double im = inv_mass[i];
@@ -52,10 +57,18 @@ void kick_drift(const Model& m, State& s, double h, double dt) {
     omega[i] = w_mid + dw;  // predicted omega(n+1)
     // NaN and inf both fail this comparison.
     finite = finite & (v_mid.squaredNorm() + w_mid.squaredNorm() < 1e300);
-    max_d2 = std::max(max_d2, (x - pos_at_build[i]).squaredNorm());
+    const double d2 = (x - pos_at_build[i]).squaredNorm();
+    if (free && reach[i] > 0) {
+      max_f2 = std::max(max_f2, d2);
+      margin = std::min(margin, reach[i] - std::sqrt(d2));
+    } else {
+      max_d2 = std::max(max_d2, d2);
+    }
   }
   s.stats.finite = finite;
   s.stats.max_disp2 = max_d2;
+  s.stats.max_free_disp2 = max_f2;
+  s.stats.free_margin = margin;
 }
 
 void finish_kick(const Model& m, State& s, double h) {

@@ -463,10 +463,113 @@ void partition_work(const Model& m, State& s) {
         int(std::lower_bound(wl.grain.begin(), wl.grain.end(), int(long(n) * q / P)) - wl.grain.begin());
 }
 
+namespace {
+
+// Free flight (docs/model.md §18). The reach of grain i: the smallest gap to
+// any other grain within reach_cells cells (grains beyond them are at least
+// reach_cells cells away, so their gap is at least that minus both radii),
+// to every wall that is on and to every body shape (a shape farther than the
+// body's bounding sphere allows is not evaluated).
+double grain_reach(const Model& m, const State& s, const Grid& g, int i, std::vector<uint32_t>& buckets) {
+  const int K = m.free_flight.reach_cells;
+  const Vec3 xi = s.pos[i];
+  const double ri = m.grain_radius[i];
+  double c = K / g.inv_cell - ri - m.max_radius;
+  auto scan = [&](int cc) {
+    for (int q = s.cell_start[cc]; q < s.cell_start[cc + 1]; ++q) {
+      const int j = s.cell_items[q];
+      if (j != i) c = std::min(c, (s.pos[j] - xi).norm() - ri - m.grain_radius[j]);
+    }
+  };
+  if (g.hashed) {
+    const Vec3 cc = (xi - g.lo) * g.inv_cell;
+    const long cx = cell_coord(cc.x()), cy = cell_coord(cc.y()), cz = cell_coord(cc.z());
+    buckets.resize(size_t(2 * K + 1) * (2 * K + 1) * (2 * K + 1));
+    const int nb = buckets_of_box(g, cx - K, cx + K, cy - K, cy + K, cz - K, cz + K, buckets);
+    for (int k = 0; k < nb; ++k) scan(int(buckets[k]));
+  } else {
+    const int cell = s.cell_of[i];
+    const int cx = cell % g.nx, cy = (cell / g.nx) % g.ny, cz = cell / (g.nx * g.ny);
+    for (int z = std::max(cz - K, 0); z <= std::min(cz + K, g.nz - 1); ++z)
+      for (int y = std::max(cy - K, 0); y <= std::min(cy + K, g.ny - 1); ++y)
+        for (int x = std::max(cx - K, 0); x <= std::min(cx + K, g.nx - 1); ++x) scan((z * g.ny + y) * g.nx + x);
+  }
+  for (size_t w = 0; w < m.walls.size(); ++w)
+    if (s.wall_on[w]) c = std::min(c, -wall_gap(m.walls[w], xi, ri).overlap);
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    const BodyModel& bm = m.bodies[b];
+    const BodyState& bs = s.bodies[b];
+    const Vec3 d = xi - bs.pos;
+    if (d.norm() - bm.bound_radius - ri >= c) continue;
+    const Vec3 p = bs.q.conjugate() * d;
+    for (const Shape& sh : bm.shapes) {
+      const ShapeGap sg = shape_gap(bm, sh, p, ri, std::max(c, 0.0));
+      if (sg.overlap != -1e300) c = std::min(c, -sg.overlap);  // -1e300: nothing within c (meshes)
+    }
+  }
+  return c;
+}
+
+// Reach of every grain without a list entry (0 for the others); the body
+// poses of this build. Off: no reach, and every grain follows the skin test.
+void build_reach(const Model& m, State& s, const Grid& g) {
+  s.free_grains = 0;
+  if (!m.free_flight.enabled) {
+    s.reach.clear();
+    return;
+  }
+  const int n = m.n_grains;
+  std::vector<uint8_t> listed(n, 0);
+  const PairList& pl = s.pairs;
+  for (int i = 0; i < n; ++i)
+    for (int k = pl.row_start[i]; k < pl.row_start[i + 1]; ++k) listed[i] = listed[pl.partner[k]] = 1;
+  for (int i : s.wall_pairs.grain) listed[i] = 1;
+  for (int i : s.body_grains.grain) listed[i] = 1;
+  s.reach.assign(n, 0.0);
+  long count = 0;
+#pragma omp parallel reduction(+ : count) if (n >= m.parallel_min_grains)
+  {
+    std::vector<uint32_t> buckets;
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      if (listed[i] || m.grain_inv_mass[i] == 0) continue;
+      s.reach[i] = grain_reach(m, s, g, i, buckets);
+      ++count;
+    }
+  }
+  s.free_grains = count;
+  s.free_grains_max = std::max(s.free_grains_max, count);
+  s.body_pos_at_full.resize(m.bodies.size());
+  s.body_q_at_full.resize(m.bodies.size());
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    s.body_pos_at_full[b] = s.bodies[b].pos;
+    s.body_q_at_full[b] = s.bodies[b].q;
+  }
+}
+
+// Largest displacement of any body point since the last full build.
+double body_displacement_since_full(const Model& m, const State& s) {
+  double worst = 0;
+  for (size_t b = 0; b < m.bodies.size() && b < s.body_pos_at_full.size(); ++b) {
+    const BodyState& bs = s.bodies[b];
+    const double angle = s.body_q_at_full[b].angularDistance(bs.q);
+    worst = std::max(worst, (bs.pos - s.body_pos_at_full[b]).norm() + angle * m.bodies[b].bound_radius);
+  }
+  return worst;
+}
+
+}  // namespace
+
 bool lists_need_rebuild(const Model& m, const State& s) {
   if (!s.lists_valid || s.rebuild_requested) return true;
   const double half = 0.5 * m.skin;
-  return s.stats.max_disp2 > half * half;
+  if (s.stats.max_disp2 > half * half) return true;  // two grains without a reach: their skin
+  if (s.reach.empty() || s.free_grains == 0) return false;
+  // A grain with a reach against anything else: its own displacement plus the
+  // largest of any other grain or body point must stay below its reach.
+  const double others = std::max(std::sqrt(std::max(s.stats.max_disp2, s.stats.max_free_disp2)),
+                                 body_displacement_since_full(m, s));
+  return others >= s.stats.free_margin;
 }
 
 void build_neighbour_lists(const Model& m, State& s) {
@@ -476,7 +579,10 @@ void build_neighbour_lists(const Model& m, State& s) {
   partition_work(m, s);
   s.pos_at_build = s.pos;
   s.stats.max_disp2 = 0;
+  s.stats.max_free_disp2 = 0;
+  s.stats.free_margin = 1e300;
   build_body_grains(m, s, g);
+  build_reach(m, s, g);
   if (sleep_active(m, s)) {
     sleep_segments(m, s);  // again: the watch list includes the new grain–body entries
     s.sleep.ref_pending = true;  // the evaluated contacts of sleeping grains changed

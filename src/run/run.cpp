@@ -495,6 +495,10 @@ RunReport Run::run() {
     rep_.discarded_energy = z.discarded_energy;
     rep_.discarded_max_speed = z.discarded_max_speed;
   }
+  if (m_.free_flight.enabled) {
+    rep_.free_flight = true;
+    rep_.free_grains_max = s_.free_grains_max;
+  }
   if (sched_on_) {
     rep_.schedule = true;
     rep_.dt_scene = sched_dt0_;

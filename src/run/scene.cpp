@@ -47,11 +47,19 @@ void SceneRun::add_run_and_observers(JsonObject& j, const Model& m, const RunRep
   run.num("rebuilds", double(rep.rebuilds)).num("body_rebuilds", double(rep.body_rebuilds));
   if (threads > 0) run.num("threads", threads);
   add_sleep_summary(run, rep);
+  add_free_flight_summary(run, rep);
   add_schedule_summary(run, rep);
   j.obj("run", run);
   JsonObject obs;
   for (Observer* o : const_cast<SceneRun*>(this)->observers()) o->summary(obs);
   j.obj("observers", obs);
+}
+
+void add_free_flight_summary(JsonObject& j, const RunReport& rep) {
+  if (!rep.free_flight) return;
+  JsonObject o;
+  o.num("free_grains_max", double(rep.free_grains_max));
+  j.obj("free_flight", o);
 }
 
 void add_sleep_summary(JsonObject& j, const RunReport& rep) {

@@ -17,10 +17,11 @@ namespace rt {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'G', 'T', 'W', 'C', 'K', 'P', 'T'};
-// 6: ticks and the stiffness schedule's state (docs/model.md §17); 5 (sleep
+// 7: free flight (docs/model.md §18): the grains' reaches and the body poses
+// of the last full build; 6 (ticks and the stiffness schedule's state, docs/model.md §17), 5 (sleep
 // state, docs/model.md §16), 4 (history slots of grain–mesh contacts), 3
 // (rigid bodies, no grain–mesh contacts) and 2 (grains only) are still read.
-constexpr uint32_t kVersion = 6;
+constexpr uint32_t kVersion = 7;
 
 // Fingerprint of the static grain description a state belongs to.
 uint64_t model_fingerprint(const Model& m) {
@@ -187,6 +188,19 @@ void save_checkpoint(const std::string& path, const Model& m, const State& s) {
   w.pod<int64_t>(q.raised);
   w.pod<uint8_t>(q.started ? 1 : 0);
   w.pod<int64_t>(q.low_since);
+  // Free flight (model.md §18).
+  w.pod<uint8_t>(s.reach.empty() ? 0 : 1);
+  if (!s.reach.empty()) {
+    w.vec(s.reach);
+    w.pod(s.stats.max_free_disp2);
+    w.pod(s.stats.free_margin);
+    w.pod<int64_t>(s.free_grains);
+    w.vec(s.body_pos_at_full);
+    std::vector<double> q4;
+    for (const Quat& q : s.body_q_at_full) q4.insert(q4.end(), {q.w(), q.x(), q.y(), q.z()});
+    w.vec(q4);
+  }
+  w.pod<int64_t>(s.free_grains_max);
   const uint64_t sum = fnv1a(w.buf.data(), w.buf.size());
   w.pod(sum);
 
@@ -217,7 +231,7 @@ State load_checkpoint(const std::string& path, const Model& m) {
   char magic[8];
   r.raw(magic, 8);
   const uint32_t version = r.pod<uint32_t>();
-  if (version != kVersion && version != 5 && version != 4 && version != 3 && version != 2)
+  if (version != kVersion && version != 6 && version != 5 && version != 4 && version != 3 && version != 2)
     r.fail("format version " + std::to_string(version) + ", this build reads version " + std::to_string(kVersion));
   const uint64_t n = r.pod<uint64_t>();
   if (n != uint64_t(m.n_grains))
@@ -324,6 +338,28 @@ State load_checkpoint(const std::string& path, const Model& m) {
     if (!std::isfinite(s.ticks) || !(s.tick_len > 0) || !std::isfinite(s.tick_len) || !(q.scale > 0) ||
         !(q.scale <= 1) || !(q.min_scale > 0) || !(q.min_scale <= q.scale))
       r.fail("stiffness schedule state is invalid");
+  }
+  if (version >= 7) {
+    if (r.pod<uint8_t>() != 0) {
+      r.vec(s.reach, n);
+      s.stats.max_free_disp2 = r.pod<double>();
+      s.stats.free_margin = r.pod<double>();
+      s.free_grains = r.pod<int64_t>();
+      r.vec(s.body_pos_at_full, m.bodies.size());
+      std::vector<double> q4;
+      r.vec(q4, 4 * m.bodies.size());
+      s.body_q_at_full.resize(m.bodies.size());
+      for (size_t b = 0; b < m.bodies.size(); ++b)
+        s.body_q_at_full[b] = Quat(q4[4 * b], q4[4 * b + 1], q4[4 * b + 2], q4[4 * b + 3]);
+      long free = 0;
+      for (double c : s.reach) {
+        if (!(c >= 0) || !std::isfinite(c)) r.fail("free-flight reach is invalid");
+        free += c > 0;
+      }
+      if (free != s.free_grains || !(s.stats.max_free_disp2 >= 0) || std::isnan(s.stats.free_margin))
+        r.fail("free-flight state is invalid");
+    }
+    s.free_grains_max = r.pod<int64_t>();
   }
   if (r.pos() + 8 != data.size()) r.fail("unexpected trailing data");
   for (int p : s.pairs.partner)

@@ -445,7 +445,7 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   const Reader rd(source);
   if (!root || !root.IsMap()) throw InputError(source + ": expected a YAML mapping at the top level");
   rd.only(root, "",
-          {"name", "seed", "gravity", "contact", "guards", "sleep", "schedule", "materials", "walls", "bodies", "grains",
+          {"name", "seed", "gravity", "contact", "guards", "sleep", "schedule", "free_flight", "materials", "walls", "bodies", "grains",
            "stages", "output"});
   Scenario sc;
   sc.file = source;
@@ -552,6 +552,12 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   q.floor = rd.number(sh, "schedule", "floor", q.floor, 1e-8, 1);
   q.after = rd.number(sh, "schedule", "after", q.after, 0, kInf);
   q.check_every = int(rd.integer(sh, "schedule", "check_every", q.check_every, 1, 1000000));
+
+  // Free flight (docs/model.md §18).
+  const YAML::Node ff = rd.map(root, "", "free_flight", false);
+  rd.only(ff, "free_flight", {"enabled", "reach_cells"});
+  m.free_flight.enabled = rd.boolean(ff, "free_flight", "enabled", false);
+  m.free_flight.reach_cells = int(rd.integer(ff, "free_flight", "reach_cells", m.free_flight.reach_cells, 1, 16));
 
   finalize_model(m);
   sc.scene_kn = m.kn;

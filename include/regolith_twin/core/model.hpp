@@ -100,6 +100,17 @@ struct SleepParams {
   bool at_start = true;   // cells quiet at the first check fall asleep at once (a relaxed bed)
 };
 
+// Free flight (docs/model.md §18): a grain with no list entry at a full list
+// build (no grain, wall or body within the skin) gets a reach: the smallest gap
+// to any grain (within reach_cells cells), wall or body shape. It then leaves
+// the skin criterion of the rebuild test and triggers a rebuild only when its
+// own displacement plus the largest displacement of anything (grain or body
+// point) could close that reach. Exact: no contact is missed, whatever moves.
+struct FreeFlightParams {
+  bool enabled = false;
+  int reach_cells = 2;     // search depth for the reach, in cells of 2 r_max + skin
+};
+
 // Stiffness schedule (docs/model.md §17): the scene's k_n is designed for the
 // largest expected relative speed (contact.v_max). When nothing moves that
 // fast any more, k_n follows the fastest possible approach, v_fast (twice the
@@ -177,6 +188,7 @@ struct Model {
   Guards guards;
   SleepParams sleep;
   ScheduleParams schedule;
+  FreeFlightParams free_flight;
 
   double max_radius = 0, min_radius = 0;  // extreme grain radii, m
 };

@@ -124,6 +124,9 @@ struct StepStats {
   long body_body_contacts = 0;   // body–body contact points
   bool finite = true;            // every velocity finite after the last kick
   double max_disp2 = 0;          // squared max displacement since the last list build, m^2
+                                 // (with free flight: of the grains without a reach)
+  double max_free_disp2 = 0;     // free flight: squared max displacement of the grains with a reach, m^2
+  double free_margin = 1e300;    // free flight: smallest reach minus own displacement since the build, m
 };
 
 // Sleep state of the grains and cells (core/sleep.hpp). The per-grain arrays
@@ -209,6 +212,13 @@ struct State {
   PairList pairs;
   WallList wall_pairs;
   std::vector<Vec3> pos_at_build;  // positions when the lists were last built
+  // Free flight (model.hpp FreeFlightParams, docs/model.md §18): per grain, the
+  // gap guaranteed at the last full build to everything it has no list entry
+  // with (0: it has an entry, or free flight is off); empty until a build.
+  std::vector<double> reach;
+  std::vector<Vec3> body_pos_at_full;  // body poses at the last full build
+  std::vector<Quat> body_q_at_full;
+  long free_grains = 0, free_grains_max = 0;  // grains with a reach at the last build, and at most
   long rebuilds = 0;
   bool lists_valid = false;
   bool rebuild_requested = false;  // rebuild at the next step (walls switched on/off)

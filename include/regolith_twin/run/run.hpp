@@ -77,6 +77,9 @@ struct RunReport {
   bool schedule = false;
   double dt_scene = 0;
   ScheduleState sched;
+  // Free flight (docs/model.md §18), when on: most grains with a reach at a build.
+  bool free_flight = false;
+  long free_grains_max = 0;
 };
 
 class Run {

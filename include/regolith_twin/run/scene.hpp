@@ -31,6 +31,8 @@ class JsonObject;
 // One run of a prepared scene: its observers, and its outputs written from them.
 // The run's sleep figures (docs/model.md §16) as j["sleep"], when sleeping was on.
 void add_sleep_summary(JsonObject& j, const RunReport& rep);
+// "free_flight": {"free_grains_max"} when free flight was on (docs/model.md §18).
+void add_free_flight_summary(JsonObject& j, const RunReport& rep);
 // The stiffness schedule's figures (docs/model.md §17) as j's "schedule", when it was on.
 void add_schedule_summary(JsonObject& j, const RunReport& rep);
 

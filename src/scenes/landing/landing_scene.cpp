@@ -195,6 +195,7 @@ void write_landing_summary(const std::string& path, const LandingScene& ls, cons
   if (threads > 0) run.num("threads", threads);
   if (rep) run.num("rebuilds", double(rep->rebuilds)).num("body_rebuilds", double(rep->body_rebuilds));
   if (rep) add_sleep_summary(run, *rep);
+  if (rep) add_free_flight_summary(run, *rep);
   if (rep) add_schedule_summary(run, *rep);
   j.obj("run", run);
   j.write(path);

@@ -46,6 +46,7 @@ class ScenarioRun : public SceneRun {
     j.num("grain_steps_per_second", double(s.step) * m.n_grains / std::max(rep.wall_seconds, 1e-9));
     j.num("list_rebuilds", double(s.rebuilds)).num("max_overlap_ratio", rep.max_overlap_ratio);
     add_sleep_summary(j, rep);
+    add_free_flight_summary(j, rep);
     add_schedule_summary(j, rep);
     JsonObject res;
     for (const auto& r : sc.resolution) res.num(r.label, r.steps);

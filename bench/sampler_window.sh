@@ -17,6 +17,7 @@ declare -A SET=(
   [off]=""
   [schedule]="--set schedule.enabled=true"
   [sleep]="--set sleep.enabled=true --set sleep.force=1e9 --set sleep.speed=5"
+  [free_flight]="--set free_flight.enabled=true"
   [all]="--set schedule.enabled=true --set sleep.enabled=true --set sleep.force=1e9 --set sleep.speed=5"
 )
 names=("$@")
@@ -39,6 +40,7 @@ run = s["run"]
 seg = "/".join(str(int(float(last[f"seg{k}_n"]))) for k in range(1, 6))
 sl, sc = run.get("sleep", {}), run.get("schedule", {})
 print(f"{name} round {r}: wall {run['wall_seconds']:.2f} s, steps {run['steps']:.0f}, "
+      f"rebuilds {run.get('rebuilds', 0):.0f}, free max {run.get('free_flight', {}).get('free_grains_max', 0):.0f}, "
       f"dt max {sc.get('dt_max', run['dt']):.3g} s, mean awake {sl.get('mean_awake', run['grains']):.0f}, "
       f"horn segments {seg}, crater depth {float(last['crater_depth']) * 1e3:.3f} mm, "
       f"ejected {int(float(last['ejected_grains']))}, collected {float(last['collected_mass']) * 1e6:.1f} mg, "

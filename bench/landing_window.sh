@@ -4,7 +4,7 @@
 # round): wall time and the lander's state at the window's end, for the
 # sleeping and active-zone settings side by side (docs/benchmarks.md, B2).
 #
-#   bench/landing_window.sh OUT_DIR [WINDOW_S] [ROUNDS] [THREADS]
+#   bench/landing_window.sh OUT_DIR [WINDOW_S] [ROUNDS] [THREADS] [SETTING...]
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BIN=${BIN:-$ROOT/build/devel/lib/regolith_twin}
@@ -20,8 +20,10 @@ declare -A SET=(
   [sleep_v1]="--set landing.active_radius=0 --set sleep.enabled=true --set sleep.force=1e9 --set sleep.speed=1"
   [sleep_v5]="--set landing.active_radius=0 --set sleep.enabled=true --set sleep.force=1e9 --set sleep.speed=5"
   [zone_sleep_v1]="--set sleep.enabled=true --set sleep.force=1e9 --set sleep.speed=1"
+  [zone_free_flight]="--set free_flight.enabled=true"
 )
-names=(zone free sleep_default sleep_v1 sleep_v5 zone_sleep_v1)
+names=("${@:5}")
+((${#names[@]})) || names=(zone free sleep_default sleep_v1 sleep_v5 zone_sleep_v1)
 for ((r = 1; r <= rounds; ++r)); do
   order=("${names[@]}")
   if ((r % 2 == 0)); then order=($(printf '%s\n' "${names[@]}" | tac)); fi
@@ -40,6 +42,7 @@ keys = ["vx", "vy", "vz"]
 v = sum(float(last[k]) ** 2 for k in keys) ** 0.5
 sl = s["run"].get("sleep", {})
 print(f"{name} round {r}: wall {s['run']['wall_seconds']:.2f} s, steps {s['run']['steps']:.0f}, "
+      f"rebuilds {s['run'].get('rebuilds', 0):.0f}, body rebuilds {s['run'].get('body_rebuilds', 0):.0f}, "
       f"mean awake {sl.get('mean_awake', float('nan')):.0f}, lander speed at end {v:.5f} m/s, "
       f"penetration {s['outcome']['max_penetration']:.5f} m", flush=True)
 PY

@@ -7,14 +7,14 @@
 #
 #   bench/b4_landing.sh SETTING FIRST LAST [THREADS]     e.g. bench/b4_landing.sh ref 1 7
 #   settings: ref (the default scene), or a profile of config/profiles/: preview,
-#   coarse2, preview_coarse2
+#   coarse2, preview_coarse2, sleep
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BIN=${BIN:-$ROOT/build/devel/lib/regolith_twin}
 setting=${1:?setting}; first=${2:?first repeat}; last=${3:?last repeat}; threads=${4:-2}
 case $setting in
   ref) args=() ;;
-  preview|coarse2|preview_coarse2) args=(--profile "$setting") ;;
+  preview|coarse2|preview_coarse2|sleep) args=(--profile "$setting") ;;
   *) echo "b4_landing: unknown setting '$setting'" >&2; exit 2 ;;
 esac
 keep=$ROOT/docs/bench/b4

@@ -46,6 +46,13 @@ RelaxedBed relax_bed(Scenario& sc, const State& s0, const std::vector<int>& plac
                      const std::string& label) {
   RelaxedBed out;
   const Model& m = sc.model;
+  if (!opt.relaxed_bed.empty()) {  // --relaxed-bed: the caller's bed, as it is
+    out.state = load_checkpoint(opt.relaxed_bed, m);
+    out.cache = opt.relaxed_bed;
+    out.from_cache = true;
+    if (!opt.quiet) std::fprintf(stderr, "[%s] relaxed bed from %s\n", label.c_str(), out.cache.c_str());
+    return out;
+  }
   const std::string cache = opt.cache_dir.empty() ? default_cache_dir() : opt.cache_dir;
   make_dirs(cache + "/beds");
   out.cache = cache + "/beds/" + bed_key(m, s0, placed) + ".ckpt";

@@ -29,6 +29,7 @@ void usage(std::FILE* f, const char* tool) {
                "  --profile P     named settings applied before any --set: profiles/P.yaml beside the scene file,\n"
                "                  or a file path (e.g. --profile preview: faster, less accurate; docs/benchmarks.md B5)\n"
                "  --cache DIR     where relaxed beds are kept (default $REGOLITH_CACHE or ~/.cache/regolith_twin)\n"
+               "  --relaxed-bed F start from this relaxed bed (a checkpoint of the same grains, e.g. a cache file)\n"
                "  --snapshot F    also write the final grains as a compact bed snapshot F (float32)\n"
                "  --snapshot-precision 32|64  positions of the snapshot in float32 (default) or float64 (stiff beds)\n"
                "  --checkpoint F  also write the exact final state (with contact history) to F\n"
@@ -41,7 +42,7 @@ void usage(std::FILE* f, const char* tool) {
 }
 
 struct Args {
-  std::string file, out, cache, snapshot, checkpoint, profile;
+  std::string file, out, cache, snapshot, checkpoint, profile, relaxed_bed;
   std::vector<std::string> overrides;
   int threads = 0;
   bool quiet = false, stage_snapshots = false;
@@ -61,11 +62,12 @@ int parse(int argc, char** argv, const char* tool, Args& a) {
       return true;
     };
     std::string v;
-    if (o == "--out" || o == "--cache" || o == "--snapshot" || o == "--checkpoint" || o == "--set" ||
+    if (o == "--out" || o == "--cache" || o == "--relaxed-bed" || o == "--snapshot" || o == "--checkpoint" || o == "--set" ||
         o == "--threads" || o == "--snapshot-precision" || o == "--profile") {
       if (!value(v)) return 2;
       if (o == "--out") a.out = v;
       else if (o == "--cache") a.cache = v;
+      else if (o == "--relaxed-bed") a.relaxed_bed = v;
       else if (o == "--snapshot") a.snapshot = v;
       else if (o == "--checkpoint") a.checkpoint = v;
       else if (o == "--set") a.overrides.push_back(v);
@@ -156,6 +158,7 @@ int run_cli(int argc, char** argv, const char* tool) {
     make_dirs(a.out);
     SceneOptions so;
     so.cache_dir = a.cache;
+    so.relaxed_bed = a.relaxed_bed;
     so.quiet = a.quiet;
     so.relax_out = a.out + "/bed_relax";
     std::unique_ptr<Scene> scene = load_scene(a.file, a.overrides, so);

@@ -24,6 +24,8 @@ struct SceneOptions {
   std::string cache_dir;   // relaxed beds (empty: default_cache_dir())
   std::string relax_out;   // output folder of a bed relaxation (empty: none written)
   bool quiet = false;      // no progress lines while preparing
+  std::string relaxed_bed; // a relaxed bed to start from instead of relaxing or the cache (a checkpoint of
+                           // the same grains, e.g. a cache file of a run at another time step)
 };
 
 class JsonObject;

@@ -50,14 +50,7 @@ rt::Shape shape(rt::ShapeType t, const Vec3& size) {
 Scene spray(bool free_flight, bool bed_and_drop = true) {
   Scene sc;
   rt::Model& m = sc.m;
-  m.materials = {rt::test::simple_material("grain", 2430, 0.5, 0.5, 0.5),
-                 rt::test::simple_material("wall", 2430, 0.5, 0.5, 0.5)};
-  m.materials[1].structure = true;
-  m.walls.push_back(rt::make_plane(Vec3::Zero(), Vec3::UnitZ(), 1));
-  m.walls.push_back(rt::make_plane(Vec3::Zero(), Vec3::UnitX(), 1));
-  m.walls.push_back(rt::make_plane(Vec3(kL, 0, 0), -Vec3::UnitX(), 1));
-  m.walls.push_back(rt::make_plane(Vec3::Zero(), Vec3::UnitY(), 1));
-  m.walls.push_back(rt::make_plane(Vec3(0, kL, 0), -Vec3::UnitY(), 1));
+  rt::test::grain_and_wall_in_open_box(m, kL);
   rt::BodyModel box;
   box.name = "box";
   box.mass = 0.05;

@@ -38,14 +38,7 @@ const Scene& settled_bed() {
   static const Scene bed = [] {
     Scene sc;
     rt::Model& m = sc.m;
-    m.materials = {rt::test::simple_material("grain", 2430, 0.5, 0.5, 0.5),
-                   rt::test::simple_material("wall", 2430, 0.5, 0.5, 0.5)};
-    m.materials[1].structure = true;
-    m.walls.push_back(rt::make_plane(Vec3::Zero(), Vec3::UnitZ(), 1));
-    m.walls.push_back(rt::make_plane(Vec3::Zero(), Vec3::UnitX(), 1));
-    m.walls.push_back(rt::make_plane(Vec3(kL, 0, 0), -Vec3::UnitX(), 1));
-    m.walls.push_back(rt::make_plane(Vec3::Zero(), Vec3::UnitY(), 1));
-    m.walls.push_back(rt::make_plane(Vec3(0, kL, 0), -Vec3::UnitY(), 1));
+    rt::test::grain_and_wall_in_open_box(m, kL);
     std::mt19937_64 rng(5);
     rt::RadiusDist d;
     d.mean = kR;

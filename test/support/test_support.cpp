@@ -1,5 +1,6 @@
 #include "test_support.hpp"
 
+#include "regolith_twin/core/walls.hpp"
 #include "regolith_twin/scene/scenario.hpp"
 
 #include <unistd.h>
@@ -51,6 +52,16 @@ Material simple_material(const std::string& name, double density, double eps_n, 
   m.mu_r = 0;
   m.mu_t = 0;
   return m;
+}
+
+void grain_and_wall_in_open_box(Model& m, double side) {
+  m.materials = {simple_material("grain", 2430, 0.5, 0.5, 0.5), simple_material("wall", 2430, 0.5, 0.5, 0.5)};
+  m.materials[1].structure = true;
+  m.walls.push_back(make_plane(Vec3::Zero(), Vec3::UnitZ(), 1));
+  m.walls.push_back(make_plane(Vec3::Zero(), Vec3::UnitX(), 1));
+  m.walls.push_back(make_plane(Vec3(side, 0, 0), -Vec3::UnitX(), 1));
+  m.walls.push_back(make_plane(Vec3::Zero(), Vec3::UnitY(), 1));
+  m.walls.push_back(make_plane(Vec3(0, side, 0), -Vec3::UnitY(), 1));
 }
 
 bool preset_with_wall(Model& m, const std::string& preset) {

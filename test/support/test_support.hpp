@@ -16,6 +16,11 @@ std::string figure(double v);
 // A material with the given restitution and friction (no rolling/twisting).
 Material simple_material(const std::string& name, double density, double eps_n, double eps_t, double mu_s);
 
+// Materials `grain` (0) and `wall` (1, a structure), both density 2430,
+// ε_n = ε_t = μ = 0.5, and an open box: a floor at z = 0 and side planes at
+// x, y = 0 and side.
+void grain_and_wall_in_open_box(Model& m, double side);
+
 // A published preset (grains, material 0) and the same material as a
 // structure named `wall` (material 1); false if the preset is unknown.
 bool preset_with_wall(Model& m, const std::string& preset);

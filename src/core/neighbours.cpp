@@ -365,14 +365,17 @@ void build_body_grains(const Model& m, State& s, const Grid& g) {
   ++s.body_rebuilds;
 }
 
+// Bound on the displacement of any point of body b since it was at (pos0, q0).
+double body_point_shift(const Model& m, const State& s, size_t b, const Vec3& pos0, const Quat& q0) {
+  const BodyState& bs = s.bodies[b];
+  return (bs.pos - pos0).norm() + q0.angularDistance(bs.q) * m.bodies[b].bound_radius;
+}
+
 // Largest displacement of any body point since the grain–body list was built.
 double max_body_displacement(const Model& m, const State& s) {
   double worst = 0;
-  for (size_t b = 0; b < m.bodies.size(); ++b) {
-    const BodyState& bs = s.bodies[b];
-    const double angle = bs.q_at_build.angularDistance(bs.q);
-    worst = std::max(worst, (bs.pos - bs.pos_at_build).norm() + angle * m.bodies[b].bound_radius);
-  }
+  for (size_t b = 0; b < m.bodies.size(); ++b)
+    worst = std::max(worst, body_point_shift(m, s, b, s.bodies[b].pos_at_build, s.bodies[b].q_at_build));
   return worst;
 }
 
@@ -470,7 +473,7 @@ namespace {
 // reach_cells cells away, so their gap is at least that minus both radii),
 // to every wall that is on and to every body shape (a shape farther than the
 // body's bounding sphere allows is not evaluated).
-double grain_reach(const Model& m, const State& s, const Grid& g, int i, std::vector<uint32_t>& buckets) {
+double grain_reach(const Model& m, const State& s, const Grid& g, int i) {
   const int K = m.free_flight.reach_cells;
   const Vec3 xi = s.pos[i];
   const double ri = m.grain_radius[i];
@@ -484,6 +487,7 @@ double grain_reach(const Model& m, const State& s, const Grid& g, int i, std::ve
   if (g.hashed) {
     const Vec3 cc = (xi - g.lo) * g.inv_cell;
     const long cx = cell_coord(cc.x()), cy = cell_coord(cc.y()), cz = cell_coord(cc.z());
+    static thread_local std::vector<uint32_t> buckets;  // capacity kept between builds
     buckets.resize(size_t(2 * K + 1) * (2 * K + 1) * (2 * K + 1));
     const int nb = buckets_of_box(g, cx - K, cx + K, cy - K, cy + K, cz - K, cz + K, buckets);
     for (int k = 0; k < nb; ++k) scan(int(buckets[k]));
@@ -519,7 +523,8 @@ void build_reach(const Model& m, State& s, const Grid& g) {
     return;
   }
   const int n = m.n_grains;
-  std::vector<uint8_t> listed(n, 0);
+  std::vector<uint8_t>& listed = s.reach_listed;  // scratch, capacity kept
+  listed.assign(n, 0);
   const PairList& pl = s.pairs;
   for (int i = 0; i < n; ++i)
     for (int k = pl.row_start[i]; k < pl.row_start[i + 1]; ++k) listed[i] = listed[pl.partner[k]] = 1;
@@ -527,15 +532,11 @@ void build_reach(const Model& m, State& s, const Grid& g) {
   for (int i : s.body_grains.grain) listed[i] = 1;
   s.reach.assign(n, 0.0);
   long count = 0;
-#pragma omp parallel reduction(+ : count) if (n >= m.parallel_min_grains)
-  {
-    std::vector<uint32_t> buckets;
-#pragma omp for schedule(static)
-    for (int i = 0; i < n; ++i) {
-      if (listed[i] || m.grain_inv_mass[i] == 0) continue;
-      s.reach[i] = grain_reach(m, s, g, i, buckets);
-      ++count;
-    }
+#pragma omp parallel for schedule(static) reduction(+ : count) if (n >= m.parallel_min_grains)
+  for (int i = 0; i < n; ++i) {
+    if (listed[i] || m.grain_inv_mass[i] == 0) continue;
+    s.reach[i] = grain_reach(m, s, g, i);
+    ++count;
   }
   s.free_grains = count;
   s.free_grains_max = std::max(s.free_grains_max, count);
@@ -550,11 +551,8 @@ void build_reach(const Model& m, State& s, const Grid& g) {
 // Largest displacement of any body point since the last full build.
 double body_displacement_since_full(const Model& m, const State& s) {
   double worst = 0;
-  for (size_t b = 0; b < m.bodies.size() && b < s.body_pos_at_full.size(); ++b) {
-    const BodyState& bs = s.bodies[b];
-    const double angle = s.body_q_at_full[b].angularDistance(bs.q);
-    worst = std::max(worst, (bs.pos - s.body_pos_at_full[b]).norm() + angle * m.bodies[b].bound_radius);
-  }
+  for (size_t b = 0; b < m.bodies.size() && b < s.body_pos_at_full.size(); ++b)
+    worst = std::max(worst, body_point_shift(m, s, b, s.body_pos_at_full[b], s.body_q_at_full[b]));
   return worst;
 }
 

@@ -149,9 +149,10 @@ Scene make_scene(int parallel_min_grains) {
   return sc;
 }
 
-void expect_steps_allocate_nothing(int threads, int parallel_min_grains) {
+void expect_steps_allocate_nothing(int threads, int parallel_min_grains, bool free_flight = false) {
   omp_set_num_threads(threads);
   Scene sc = make_scene(parallel_min_grains);
+  sc.m.free_flight.enabled = free_flight;  // the reach build at every rebuild (model.md §18)
   for (int k = 0; k < 300; ++k) rt::step(sc.m, sc.s);  // warm-up (thread pool, first lists)
   constexpr int kWindow = 5000;
   const long rebuilds0 = sc.s.rebuilds;
@@ -325,6 +326,8 @@ TEST(Allocation, CounterSeesOperatorNew) {
 TEST(Allocation, SerialStepsAllocateNothing) { expect_steps_allocate_nothing(1, 1 << 30); }
 
 TEST(Allocation, ParallelStepsAllocateNothing) { expect_steps_allocate_nothing(2, 0); }
+
+TEST(Allocation, StepsWithFreeFlightAllocateNothing) { expect_steps_allocate_nothing(2, 0, true); }
 
 TEST(Allocation, SerialStepsWithBodiesAllocateNothing) { expect_body_steps_allocate_nothing(1, 1 << 30); }
 

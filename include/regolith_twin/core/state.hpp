@@ -219,6 +219,7 @@ struct State {
   std::vector<Vec3> body_pos_at_full;  // body poses at the last full build
   std::vector<Quat> body_q_at_full;
   long free_grains = 0, free_grains_max = 0;  // grains with a reach at the last build, and at most
+  std::vector<uint8_t> reach_listed;  // scratch of the reach build: grain has a list entry
   long rebuilds = 0;
   bool lists_valid = false;
   bool rebuild_requested = false;  // rebuild at the next step (walls switched on/off)

@@ -9,6 +9,12 @@ was stopped is re-run with the same command and continues: finished runs
 (summary.json with status ok) are skipped, unfinished or failed ones redone.
 Afterwards (or with --report-only) OUT/aggregate.csv, OUT/*.png and
 OUT/report.md are written from every run in OUT/runs.
+
+With --record DIR every finished run is also kept as one small JSON,
+DIR/<run>.json (its summary and how it was run, paths relative to the
+repository), meant to be committed: a sweep with the same --record on another
+machine takes those runs as done (their summaries, without the series and
+plots) and runs only the rest.
 """
 import argparse
 import concurrent.futures
@@ -98,6 +104,65 @@ def is_done(run_dir):
     s = read_json(os.path.join(run_dir, "summary.json"))
     meta = read_json(os.path.join(run_dir, "sweep_run.json"))
     return bool(s) and s.get("status") == "ok" and bool(meta) and meta.get("exit_code") == 0
+
+
+def to_portable(x):
+    """Paths under the repository written as $ROOT/..., recursively."""
+    if isinstance(x, str):
+        return x.replace(ROOT + os.sep, "$ROOT/")
+    if isinstance(x, list):
+        return [to_portable(v) for v in x]
+    if isinstance(x, dict):
+        return {k: to_portable(v) for k, v in x.items()}
+    return x
+
+
+def from_portable(x):
+    if isinstance(x, str):
+        return x.replace("$ROOT/", ROOT + os.sep)
+    if isinstance(x, list):
+        return [from_portable(v) for v in x]
+    if isinstance(x, dict):
+        return {k: from_portable(v) for k, v in x.items()}
+    return x
+
+
+def write_record(record_dir, run_dir):
+    """DIR/<run>.json of a finished run (written to a temporary name, then renamed)."""
+    meta = read_json(os.path.join(run_dir, "sweep_run.json"))
+    summary = read_json(os.path.join(run_dir, "summary.json"))
+    if not meta or not summary:
+        return
+    os.makedirs(record_dir, exist_ok=True)
+    path = os.path.join(record_dir, os.path.basename(run_dir) + ".json")
+    with open(path + ".tmp", "w") as f:
+        json.dump(to_portable({"sweep_run": meta, "summary": summary}), f, indent=1)
+        f.write("\n")
+    os.replace(path + ".tmp", path)
+
+
+def restore_records(a, grid):
+    """Runs recorded in a.record and not finished in OUT/runs become finished runs there."""
+    restored = 0
+    for p in grid:
+        name = run_name(*p)
+        d = os.path.join(a.out, "runs", name)
+        rec = read_json(os.path.join(a.record, name + ".json"))
+        if is_done(d) or not rec or "sweep_run" not in rec or "summary" not in rec:
+            continue
+        rec = from_portable(rec)
+        if rec["summary"].get("status") != "ok" or rec["sweep_run"].get("exit_code") != 0:
+            continue
+        if os.path.exists(d):
+            shutil.rmtree(d)
+        os.makedirs(d)
+        rec["sweep_run"]["restored_from"] = os.path.join(a.record, name + ".json")
+        for f, v in (("sweep_run.json", rec["sweep_run"]), ("summary.json", rec["summary"])):
+            with open(os.path.join(d, f), "w") as fh:
+                json.dump(v, fh, indent=1)
+        restored += 1
+    if restored:
+        print(f"sweep: {restored} finished run(s) taken from {a.record}", flush=True)
 
 
 def fmt_time(sec):
@@ -208,6 +273,8 @@ def run_one(a, land, point, bed, out_runs, index, total, eta_text):
     if os.path.exists(final):
         shutil.rmtree(final)
     os.rename(tmp, final)
+    if status == "ok" and a.record:
+        write_record(a.record, final)
     if status == "ok" and not a.no_run_plots:
         plot_run(final)
     return rc, status, wall, summary
@@ -216,6 +283,8 @@ def run_one(a, land, point, bed, out_runs, index, total, eta_text):
 def sweep(a, grid, land):
     out_runs = os.path.join(a.out, "runs")
     os.makedirs(out_runs, exist_ok=True)
+    if a.record:
+        restore_records(a, grid)
     total = len(grid)
     todo = [(i, p) for i, p in enumerate(grid, 1) if not is_done(os.path.join(out_runs, run_name(*p)))]
     # Finished runs are only reused when they were made with the same settings.
@@ -530,7 +599,8 @@ def run_plots(a, rows):
         return
     for r in rows:
         d = os.path.join(a.out, "runs", r["run"])
-        if r["status"] == "ok" and not os.path.exists(os.path.join(d, "surface.png")):
+        restored = (read_json(os.path.join(d, "sweep_run.json")) or {}).get("restored_from")
+        if r["status"] == "ok" and not restored and not os.path.exists(os.path.join(d, "surface.png")):
             plot_run(d)
 
 
@@ -580,12 +650,15 @@ def main(argv=None):
     ap.add_argument("--regolith-only", action="store_true",
                     help="set only materials.regolith.preset (container and lander keep the file's presets)")
     ap.add_argument("--no-run-plots", action="store_true", help="no per-run plots (plot_landing.py)")
+    ap.add_argument("--record", default="",
+                    help="folder of one small JSON per finished run (to commit); runs recorded there count as done")
     ap.add_argument("--report-only", action="store_true", help="only write aggregate.csv, plots, report.md")
     ap.add_argument("--dry-run", action="store_true", help="list the runs and their state, run nothing")
     a = ap.parse_args(argv)
     a.out = os.path.abspath(a.out)
     a.config = os.path.abspath(a.config)
     a.bed_dir = os.path.abspath(a.bed_dir)
+    a.record = os.path.abspath(a.record) if a.record else ""
     if a.report_only:
         report(a)
         return 0

@@ -98,6 +98,31 @@ class SweepTest(unittest.TestCase):
         self.assertLessEqual(most, 3, spans)
         self.assertEqual(p.stdout.count(" done  "), 6, p.stdout)
 
+    def test_record_resumes_elsewhere(self):
+        # Every finished run leaves one JSON in --record; a new output folder
+        # with the same record runs only what is not recorded.
+        rec = os.path.join(self.dir, "record")
+        p = self.sweep("--record", rec, "--no-run-plots", env={"FAKE_LAND_FAIL": "gravel_d30_Flat_a30_r1"})
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        names = sorted(os.listdir(rec))
+        self.assertEqual(len(names), 23)
+        self.assertNotIn("gravel_d30_Flat_a30_r1.json", names)
+        with open(os.path.join(rec, "moderate_d30_BCF_a30_r0.json")) as f:
+            first = json.load(f)
+        self.assertEqual(first["summary"]["status"], "ok")
+        self.assertEqual(first["sweep_run"]["exit_code"], 0)
+        shutil.rmtree(self.out)
+        p = self.sweep("--record", rec, "--no-run-plots")
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        self.assertIn("23 finished run(s) taken from", p.stdout)
+        self.assertIn("23 already done, 1 to run", p.stdout)
+        rows = {r["run"]: r for r in self.rows()}
+        self.assertEqual(len(rows), 24)
+        self.assertTrue(all(r["status"] == "ok" for r in rows.values()))
+        self.assertAlmostEqual(float(rows["moderate_d30_BCF_a30_r0"]["speed_ratio"]),
+                               first["summary"]["outcome"]["speed_ratio"], places=12)
+        self.assertEqual(len(os.listdir(rec)), 24)
+
     def test_missing_bed(self):
         os.remove(os.path.join(self.beds, "mascot_gravel_d30.bed"))
         p = self.sweep()

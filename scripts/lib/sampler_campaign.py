@@ -1,0 +1,183 @@
+#!/usr/bin/env python3
+"""The sampler campaign (scripts/validate_sampler campaign): 1 s shots at 300
+and 50 m/s on perturbed beds, side by side.
+
+usage: sampler_campaign.py OUT_DIR DOCS_DIR
+
+For every campaign run c<speed>_r<repeat>: OUT_DIR/<run>/series.csv (when the
+run was made on this machine) is thinned to DOCS_DIR/<run>/series_thin.csv (at
+most 400 rows, kept with the run's summary); then DOCS_DIR/campaign.md (one
+row per shot, mean and SD per speed) and DOCS_DIR/campaign_*.png (collected
+mass, crater depth and radius, grains in the horn against time; ejection
+angle histograms) are written from DOCS_DIR.
+"""
+import csv
+import json
+import math
+import os
+import re
+import sys
+
+RUN = re.compile(r"^c(\d+)_r(\d+)$")
+
+
+def thin(src, dst, rows_max=400):
+    with open(src) as f:
+        rows = list(csv.reader(f))
+    head, body = rows[0], rows[1:]
+    step = max(1, math.ceil(len(body) / rows_max))
+    keep = body[::step]
+    if body and keep[-1] is not body[-1]:
+        keep.append(body[-1])
+    with open(dst, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(head)
+        w.writerows(keep)
+
+
+def read_series(path):
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return {k: [float(r[k]) for r in rows] for k in rows[0]} if rows else None
+
+
+def mean_sd(xs):
+    xs = [x for x in xs if x is not None]
+    if not xs:
+        return None, None
+    m = sum(xs) / len(xs)
+    sd = math.sqrt(sum((x - m) ** 2 for x in xs) / (len(xs) - 1)) if len(xs) > 1 else None
+    return m, sd
+
+
+def fmt(m, sd, scale=1.0, digits=1):
+    if m is None:
+        return "–"
+    return f"{m * scale:.{digits}f}" + ("" if sd is None else f" ± {sd * scale:.{digits}f}")
+
+
+def outcome(s):
+    o = s["observers"]
+    h, c, ej = o.get("horn", {}), o.get("crater", {}), o.get("ejection", {})
+    zm = o.get("zmodel", {})
+    zlast = None
+    for k in sorted((k for k in zm if isinstance(zm[k], dict)), key=lambda k: zm[k].get("t", 0)):
+        zlast = zm[k]
+    return {
+        "collected_mg": 1e6 * h.get("collected_mass", 0.0),
+        "time_met": h.get("time_met"),
+        "in_horn": sum(h.get("segment_grains", [])),
+        "segments": h.get("segment_grains", []),
+        "crater_depth_mm": 1e3 * c.get("depth", 0.0),
+        "crater_radius_mm": 1e3 * c.get("radius", 0.0),
+        "ejected": ej.get("count", 0),
+        "ejected_cm3": 1e6 * ej.get("volume", 0.0),
+        "angle_mean": ej.get("mean_angle_deg"),
+        "angle_median": ej.get("median_angle_deg"),
+        "hist": ej.get("angle_histogram", []),
+        "bin_deg": ej.get("bin_deg", 6),
+        "z": (zlast or {}).get("fixed_h0", {}).get("z"),
+        "z_t": (zlast or {}).get("t"),
+        "wall": s["run"].get("wall_seconds"),
+        "threads": s["run"].get("threads"),
+        "steps": s["run"].get("steps"),
+        "sim": s["run"].get("sim_time"),
+    }
+
+
+def main():
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    out, docs = sys.argv[1], sys.argv[2]
+    runs = {}
+    for name in sorted(os.listdir(docs)):
+        m = RUN.match(name)
+        p = os.path.join(docs, name, "summary.json")
+        if not m or not os.path.isfile(p):
+            continue
+        src = os.path.join(out, name, "series.csv")
+        if os.path.isfile(src):
+            thin(src, os.path.join(docs, name, "series_thin.csv"))
+        with open(p) as f:
+            s = json.load(f)
+        runs[name] = (int(m.group(1)), int(m.group(2)), s, outcome(s))
+    if not runs:
+        sys.exit(f"sampler_campaign: no campaign runs (c<speed>_r<repeat>/summary.json) in {docs}")
+
+    lines = ["| shot | speed m/s | bed repeat | collected at 1 s mg | 100 mg reached at s | grains in horn (cyl. 1-5) | "
+             "crater depth / radius mm | ejected grains (cm³) | ejection angle mean / median deg | Z (H0 = 0) | steps | wall s (threads) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for name, (v, rep, s, o) in runs.items():
+        lines.append(
+            f"| {name} | {v} | {rep} | {o['collected_mg']:.1f} | "
+            f"{'–' if o['time_met'] is None else format(o['time_met'], '.3f')} | "
+            f"{'/'.join(str(x) for x in o['segments'])} | {o['crater_depth_mm']:.0f} / {o['crater_radius_mm']:.0f} | "
+            f"{o['ejected']} ({o['ejected_cm3']:.0f}) | "
+            f"{'–' if o['angle_mean'] is None else format(o['angle_mean'], '.1f')} / "
+            f"{'–' if o['angle_median'] is None else format(o['angle_median'], '.1f')} | "
+            f"{'–' if o['z'] is None else format(o['z'], '.2f')} | {o['steps']} | "
+            f"{o['wall']:.0f} ({o['threads']}) |")
+    lines += ["", "Per speed, mean ± SD over the shots (SD from n − 1):", "",
+              "| speed m/s | shots | collected mg | grains in horn | crater depth mm | crater radius mm | ejected grains | "
+              "mean ejection angle deg | Z |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    for v in sorted({r[0] for r in runs.values()}, reverse=True):
+        os_ = [r[3] for r in runs.values() if r[0] == v]
+
+        def col(key, digits=1):
+            return fmt(*mean_sd([o[key] for o in os_]), digits=digits)
+        lines.append(f"| {v} | {len(os_)} | {col('collected_mg')} | {col('in_horn', 0)} | {col('crater_depth_mm')} | "
+                     f"{col('crater_radius_mm')} | {col('ejected', 0)} | {col('angle_mean')} | {col('z', 2)} |")
+    with open(os.path.join(docs, "campaign.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print("sampler_campaign: matplotlib missing, no plots", file=sys.stderr)
+        return 0
+    colours = {300: "tab:red", 50: "tab:blue"}
+    styles = ["-", "--", ":", "-."]
+    fig, ax = plt.subplots(2, 2, figsize=(11, 7.5))
+    for name, (v, rep, s, o) in runs.items():
+        ser = read_series(os.path.join(docs, name, "series_thin.csv"))
+        if ser is None:
+            continue
+        t = ser["t"]
+        kw = dict(color=colours.get(v, "k"), ls=styles[rep % len(styles)], label=f"{v} m/s, bed {rep}")
+        ax[0][0].plot(t, [1e6 * x for x in ser["collected_mass"]], **kw)
+        ax[0][1].plot(t, [sum(ser[f"seg{k}_n"][i] for k in range(1, 6)) for i in range(len(t))], **kw)
+        ax[1][0].plot(t, [1e3 * x for x in ser["crater_depth"]], **kw)
+        ax[1][1].plot(t, [1e3 * x for x in ser["crater_radius"]], **kw)
+    ax[0][0].axhline(100, color="k", lw=0.8, ls="--", label="100 mg")
+    for a, lab in zip(ax.flat, ["collected mass (mg)", "grains in the horn", "crater depth (mm)",
+                                "crater radius (mm)"]):
+        a.set_xlabel("time after firing (s)")
+        a.set_ylabel(lab)
+    ax[0][0].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(docs, "campaign_series.png"), dpi=110)
+    plt.close(fig)
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    for name, (v, rep, s, o) in runs.items():
+        h, b = o["hist"], o["bin_deg"]
+        if not h:
+            continue
+        tot = float(sum(h)) or 1.0
+        ax.step([b * (i + 0.5) for i in range(len(h))], [x / tot for x in h], where="mid",
+                color=colours.get(v, "k"), ls=styles[rep % len(styles)], label=f"{v} m/s, bed {rep}")
+    ax.set_xlabel("ejection angle from the horizontal (deg)")
+    ax.set_ylabel("fraction of ejected grains")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(docs, "campaign_ejection_angles.png"), dpi=110)
+    plt.close(fig)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -112,7 +112,7 @@ def main():
     for name, (v, rep, s, o) in runs.items():
         lines.append(
             f"| {name} | {v} | {rep} | {o['collected_mg']:.1f} | "
-            f"{'–' if o['time_met'] is None else format(o['time_met'], '.3f')} | "
+            f"{'not reached' if o['time_met'] is None or o['time_met'] < 0 else format(o['time_met'], '.3f')} | "
             f"{'/'.join(str(x) for x in o['segments'])} | {o['crater_depth_mm']:.0f} / {o['crater_radius_mm']:.0f} | "
             f"{o['ejected']} ({o['ejected_cm3']:.0f}) | "
             f"{'–' if o['angle_mean'] is None else format(o['angle_mean'], '.1f')} / "

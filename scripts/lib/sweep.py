@@ -502,18 +502,24 @@ def fmt(x, digits=3):
     return str(x)
 
 
+def shown(path):
+    """A path as the report shows it: relative to the repository when inside it."""
+    p = os.path.abspath(path)
+    return os.path.relpath(p, ROOT) if p.startswith(ROOT + os.sep) else p
+
+
 def write_report(out, rows, outcome_keys, plots, spread, grid_meta):
     ok = [r for r in rows if r["status"] == "ok"]
     bad = [r for r in rows if r["status"] != "ok"]
     L = ["# MASCOT landing sweep", ""]
-    L.append(f"Folder: `{out}` ({len(rows)} runs: {len(ok)} ok, {len(bad)} failed or unfinished).")
+    L.append(f"Folder: `{shown(out)}` ({len(rows)} runs: {len(ok)} ok, {len(bad)} failed or unfinished).")
     if grid_meta:
         L.append("")
         L.append("Grid of the last sweep command:")
         L.append("")
         for k in ("materials", "depths", "attitudes", "angles", "repeats"):
             L.append(f"- {k}: {', '.join(fmt_num(x) if isinstance(x, float) else str(x) for x in grid_meta[k])}")
-        L.append(f"- landing file: `{grid_meta['config']}`, beds from `{grid_meta['bed_dir']}`")
+        L.append(f"- landing file: `{shown(grid_meta['config'])}`, beds from `{shown(grid_meta['bed_dir'])}`")
         if grid_meta.get("set"):
             L.append(f"- overrides: {', '.join('`' + s + '`' for s in grid_meta['set'])}")
         if grid_meta.get("threads"):

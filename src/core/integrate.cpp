@@ -119,6 +119,9 @@ inline Vec3 total_torque(const State& s, size_t b) {
 // splitting of the free rigid body over dt (free_rotation), then the second
 // kick. Angular velocities follow from L and the current orientation.
 void kick_drift_bodies(const Model& m, State& s, double h, double dt) {
+  s.stats.bad_body = -1;
+  s.stats.max_body_step = 0;
+  s.stats.max_body_step_body = -1;
   for (size_t b = 0; b < m.bodies.size(); ++b) {
     const BodyModel& bm = m.bodies[b];
     BodyState& bs = s.bodies[b];
@@ -133,7 +136,16 @@ void kick_drift_bodies(const Model& m, State& s, double h, double dt) {
     bs.omega_mid = inv_i * bs.ang_mom;
     bs.vel = bs.vel_mid + dv;                     // predicted v(n+1)
     bs.omega = inv_i * (bs.ang_mom + h * torque);  // predicted omega(n+1)
-    if (!(bs.vel.squaredNorm() + bs.omega.squaredNorm() < 1e300)) s.stats.finite = false;
+    if (!(bs.vel.squaredNorm() + bs.omega.squaredNorm() < 1e300) || !bs.pos.allFinite() || !bs.q.coeffs().allFinite()) {
+      s.stats.finite = false;
+      if (s.stats.bad_body < 0) s.stats.bad_body = int(b);
+    }
+    // Largest drift of a point of the body in this step (tunnelling guard, docs/model.md §13).
+    const double drift = dt * (bs.vel_mid.norm() + bs.omega_mid.norm() * bm.bound_radius);
+    if (drift > s.stats.max_body_step) {
+      s.stats.max_body_step = drift;
+      s.stats.max_body_step_body = int(b);
+    }
   }
 }
 
@@ -145,7 +157,10 @@ void finish_kick_bodies(const Model& m, State& s, double h) {
     bs.vel = bs.vel_mid + h * (total_force(s, b) / bm.mass + m.gravity);
     bs.ang_mom += h * total_torque(s, b);
     bs.omega = inverse_inertia_world(bm, bs.q) * bs.ang_mom;
-    if (!(bs.vel.squaredNorm() + bs.omega.squaredNorm() < 1e300)) s.stats.finite = false;
+    if (!(bs.vel.squaredNorm() + bs.omega.squaredNorm() < 1e300)) {
+      s.stats.finite = false;
+      if (s.stats.bad_body < 0) s.stats.bad_body = int(b);
+    }
   }
 }
 

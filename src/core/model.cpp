@@ -165,6 +165,19 @@ void finalize_model(Model& m) {
       m.pair_law[a * nm + b] = L;
     }
   if (m.skin <= 0) m.skin = 0.5 * m.max_radius;
+  // Tunnelling guard (docs/model.md §13): in one step a body point may drift
+  // at most the list skin (a grain could otherwise be passed) and, with two
+  // or more bodies, the half thickness of the thinnest shape that is not a mesh.
+  double limit = 0;
+  const auto take = [&limit](double v) {
+    if (v > 0) limit = limit > 0 ? std::min(limit, v) : v;
+  };
+  if (!m.bodies.empty() && m.n_grains > 0) take(m.skin);
+  if (m.bodies.size() >= 2)
+    for (const BodyModel& b : m.bodies)
+      for (const Shape& sh : b.shapes)
+        if (sh.type != ShapeType::Mesh) take(sh.size.minCoeff());
+  m.body_step_limit = limit;
   build_body_geometry(m);
 }
 

@@ -71,10 +71,30 @@ void step(const Model& m, State& s) {
 
 void check_guards(const Model& m, const State& s) {
   const StepStats& st = s.stats;
+  if (!st.finite && st.bad_body >= 0) {
+    const BodyState& b = s.bodies[st.bad_body];
+    std::ostringstream os;
+    os << "numerical blow-up at step " << s.step << " (t = " << s.time << " s): the state of body '"
+       << m.bodies[st.bad_body].name << "' became NaN or infinite (position " << b.pos.transpose() << ", velocity "
+       << b.vel.transpose() << ", force " << b.force.transpose()
+       << "); check the body's initial state and applied wrench, reduce dt or the body stiffness (body_kn)";
+    throw BlowUpError(os.str());
+  }
   if (!st.finite) {
     std::ostringstream os;
     os << "numerical blow-up at step " << s.step << " (t = " << s.time
        << " s): a grain velocity became NaN or infinite; reduce dt or k_n (see the steps-per-contact report)";
+    throw BlowUpError(os.str());
+  }
+  if (m.guards.max_body_step_ratio > 0 && m.body_step_limit > 0 &&
+      st.max_body_step > m.guards.max_body_step_ratio * m.body_step_limit) {
+    const int b = st.max_body_step_body;
+    std::ostringstream os;
+    os << "numerical blow-up at step " << s.step << " (t = " << s.time << " s): body '" << m.bodies[b].name
+       << "' moved " << st.max_body_step << " m in one step (speed " << s.bodies[b].vel_mid.norm()
+       << " m/s), more than " << m.guards.max_body_step_ratio * m.body_step_limit
+       << " m (the contact skin or the thinnest body shape, docs/model.md §13): it could pass through what it "
+          "should hit; reduce dt (or the body's speed), or set guards.max_body_step_ratio";
     throw BlowUpError(os.str());
   }
   if (st.max_overlap_ratio > m.guards.max_overlap_ratio) {

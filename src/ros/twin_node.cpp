@@ -127,6 +127,8 @@ TwinNode::TwinNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeParams& p)
 #ifdef _OPENMP
   if (p_.threads > 0) omp_set_num_threads(p_.threads);
 #endif
+  // The output folder is taken (and checked) before the scene is prepared, not at the run's end.
+  if (!p_.out_dir.empty()) out_folder_ = std::make_unique<rt::OutputFolder>(p_.out_dir);
   rt::TwinOptions to;
   to.file = p_.scenario_file;
   to.overrides = p_.overrides;
@@ -287,7 +289,6 @@ void TwinNode::on_end() {
     threads = omp_get_max_threads();
 #endif
     try {
-      rt::make_dirs(p_.out_dir);
       twin_->write_files(p_.out_dir);
       twin_->write_summary(p_.out_dir + "/summary.json", failed_ ? "blow_up" : "ok", failure_, threads);
       ROS_INFO("twin_node: summary and the scene's files written to %s", p_.out_dir.c_str());
@@ -821,11 +822,16 @@ bool TwinNode::on_set_body_state(regolith_twin::SetBodyState::Request& req, rego
     res.message = "body '" + req.body + "' is fixed";
   } else {
     const auto& p = req.pose.position;
-    twin_->set_body_state(b, Vec3(p.x, p.y, p.z), Quat(o.w, o.x, o.y, o.z), from_vector(req.twist.linear),
-                          from_vector(req.twist.angular));
-    publish_body_states();
-    res.success = true;
-    res.message = "ok";
+    try {
+      twin_->set_body_state(b, Vec3(p.x, p.y, p.z), Quat(o.w, o.x, o.y, o.z), from_vector(req.twist.linear),
+                            from_vector(req.twist.angular));
+      publish_body_states();
+      res.success = true;
+      res.message = "ok";
+    } catch (const rt::InputError& e) {  // a non-finite pose or twist: the state is left as it was
+      res.success = false;
+      res.message = e.what();
+    }
   }
   return true;
 }

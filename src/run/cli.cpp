@@ -14,6 +14,7 @@
 #endif
 
 #include "regolith_twin/run/scene.hpp"
+#include "regolith_twin/run/series.hpp"
 #include "regolith_twin/scene/checkpoint.hpp"
 #include "regolith_twin/scene/snapshot.hpp"
 
@@ -155,7 +156,9 @@ int run_cli(int argc, char** argv, const char* tool) {
       a.overrides = std::move(o);
     }
     if (a.out.empty()) a.out = "out/" + load_document(a.file, a.overrides)["name"].as<std::string>("scenario");
-    make_dirs(a.out);
+    const OutputFolder out_folder(a.out);  // refused at once if in use or not writable
+    if (!a.snapshot.empty()) check_writable(a.snapshot);
+    if (!a.checkpoint.empty()) check_writable(a.checkpoint);
     SceneOptions so;
     so.cache_dir = a.cache;
     so.relaxed_bed = a.relaxed_bed;

@@ -1,10 +1,15 @@
 // CSV series and JSON summary writers.
 #include "regolith_twin/run/series.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <sstream>
 
 #include "regolith_twin/core/types.hpp"
@@ -50,6 +55,46 @@ void make_dirs(const std::string& dir) {
   }
   struct stat st {};
   if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) throw InputError(dir + ": cannot create the folder");
+}
+
+std::string temp_name(const std::string& path) { return path + ".tmp." + std::to_string(::getpid()); }
+
+OutputFolder::OutputFolder(const std::string& dir) {
+  make_dirs(dir);
+  const std::string lock = dir + "/.regolith_twin.lock";
+  fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw InputError(dir + ": cannot write in the output folder (" + std::strerror(errno) + ")");
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    char buf[32] = {0};
+    const ssize_t n = ::pread(fd_, buf, sizeof buf - 1, 0);
+    ::close(fd_);
+    fd_ = -1;
+    const std::string pid = n > 0 ? std::string(buf, size_t(n)) : std::string("?");
+    throw InputError(dir + ": the output folder is in use by another run (pid " + pid.substr(0, pid.find('\n')) +
+                     "); give another output folder or wait until that run ends");
+  }
+  const std::string pid = std::to_string(::getpid()) + "\n";
+  if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, pid.data(), pid.size(), 0) != ssize_t(pid.size())) {
+    ::close(fd_);
+    fd_ = -1;
+    throw InputError(dir + ": cannot write in the output folder (" + std::strerror(errno) + ")");
+  }
+  // The summary of an earlier run would look finished beside this run's partial outputs.
+  const std::string summary = dir + "/summary.json";
+  if (std::remove(summary.c_str()) != 0 && errno != ENOENT)
+    throw InputError(summary + ": cannot remove the summary of an earlier run (" + std::strerror(errno) + ")");
+}
+
+OutputFolder::~OutputFolder() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void check_writable(const std::string& path) {
+  const std::string probe = temp_name(path) + ".probe";
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) throw InputError(path + ": cannot be written (" + std::strerror(errno) + ")");
+  ::close(fd);
+  ::unlink(probe.c_str());
 }
 
 CsvSeries::~CsvSeries() { close(); }
@@ -121,13 +166,15 @@ std::string JsonObject::dump(int indent) const {
 }
 
 void JsonObject::write(const std::string& path) const {
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = temp_name(path);
   std::FILE* f = std::fopen(tmp.c_str(), "w");
   if (!f) throw InputError(path + ": cannot create output file");
   const std::string text = dump(0) + "\n";
   const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path.c_str()) != 0)
+  if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
     throw InputError(path + ": could not write output file");
+  }
 }
 
 }  // namespace rt

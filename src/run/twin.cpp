@@ -1,10 +1,20 @@
 // A running twin (see twin.hpp).
 #include "regolith_twin/run/twin.hpp"
 
+#include <cmath>
+#include <sstream>
+
 #include "regolith_twin/core/step.hpp"
 #include "regolith_twin/scene/checkpoint.hpp"
 
 namespace rt {
+namespace {
+std::string vec_text(const Vec3& v) {
+  std::ostringstream os;
+  os << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
+  return os.str();
+}
+}  // namespace
 
 Twin::Twin(const TwinOptions& opt) : file_(opt.file) {
   scene_ = load_scene(opt.file, opt.overrides, opt.scene);
@@ -94,6 +104,10 @@ BodyContacts Twin::contacts(int b) const { return body_contacts(state_, b, scene
 void Twin::set_body_state(int b, const Vec3& ref_pos, const Quat& ref_q, const Vec3& vel, const Vec3& omega) {
   const BodyModel& bm = model_.bodies.at(b);
   BodyState& bs = state_.bodies.at(b);
+  const double qn = ref_q.norm();
+  if (!ref_pos.allFinite() || !vel.allFinite() || !omega.allFinite() || !(qn > 1e-9) || !std::isfinite(qn))
+    throw InputError("body '" + bm.name + "': the new state must be finite with a non-zero orientation (position " +
+                     vec_text(ref_pos) + ", velocity " + vec_text(vel) + ", angular velocity " + vec_text(omega) + ")");
   const Quat q_ref = ref_q.normalized();
   bs.q = (q_ref * bm.ref_rot).normalized();
   bs.pos = ref_pos + q_ref * bm.ref_pos;

@@ -9,6 +9,9 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <string>
+#include <tuple>
+#include <utility>
 
 #include "regolith_twin/core/hash.hpp"
 #include "regolith_twin/core/neighbours.hpp"
@@ -116,6 +119,110 @@ void get_springs(Reader& r, List& l, uint64_t n) {
   r.vec(l.touching, n);
 }
 
+bool finite(const Vec3& v) { return v.allFinite(); }
+bool finite(double v) { return std::isfinite(v); }
+bool finite(const Quat& q) { return q.coeffs().allFinite(); }
+
+// Every value a step reads is checked after the checksum: finite numbers,
+// flags 0 or 1, lists sorted as the builders leave them with indices in
+// range (docs/architecture.md, checkpoints). The checksum proves the file is
+// the one written; this proves it holds a state the engine can step.
+void check_state(Reader& r, const Model& m, const State& s) {
+  const int n = m.n_grains;
+  const auto where = [](const char* what, size_t k) { return std::string(what) + " " + std::to_string(k); };
+  if (!std::isfinite(s.time) || s.step < 0 || s.rebuilds < 0 || !(s.stats.max_disp2 >= 0) ||
+      !std::isfinite(s.stats.max_disp2))
+    r.fail("clock or step counters are invalid (time " + std::to_string(s.time) + ", step " +
+           std::to_string(s.step) + ")");
+  const std::pair<const char*, const std::vector<Vec3>*> grain_vecs[] = {
+      {"position", &s.pos}, {"velocity", &s.vel}, {"angular velocity", &s.omega},
+      {"force", &s.force},   {"torque", &s.torque}, {"position at the last list build", &s.pos_at_build}};
+  for (const auto& [what, v] : grain_vecs)
+    for (size_t i = 0; i < v->size(); ++i)
+      if (!finite((*v)[i])) r.fail(std::string("grain ") + std::to_string(i) + " has a non-finite " + what);
+  // Grain pairs: rows of partners j > i, ascending; springs finite, flags 0/1.
+  const PairList& pl = s.pairs;
+  if (!pl.row_start.empty() || !pl.partner.empty()) {
+    if (pl.row_start.size() != size_t(n) + 1 || pl.row_start[0] != 0 ||
+        size_t(pl.row_start[n]) != pl.partner.size())
+      r.fail("pair list rows do not match the grain count and the entries");
+    for (int i = 0; i < n; ++i) {
+      if (pl.row_start[i + 1] < pl.row_start[i]) r.fail("pair list rows are not in order (" + where("grain", i) + ")");
+      int last = i;
+      for (int k = pl.row_start[i]; k < pl.row_start[i + 1]; ++k) {
+        if (pl.partner[k] <= last || pl.partner[k] >= n)
+          r.fail("pair list refers to a grain that does not exist or is out of order (" + where("entry", k) + ")");
+        last = pl.partner[k];
+      }
+    }
+  }
+  const auto springs = [&r, &where](const auto& l, const char* list) {
+    for (size_t k = 0; k < l.spring_t.size(); ++k)
+      if (!finite(l.spring_t[k]) || !finite(l.spring_r[k]) || !finite(l.spring_w[k]) || l.touching[k] > 1)
+        r.fail(std::string(list) + " holds a non-finite spring or an invalid contact flag (" + where("entry", k) + ")");
+  };
+  springs(pl, "pair list");
+  // Grain–wall entries sorted by (grain, wall) without repeats.
+  const WallList& wl = s.wall_pairs;
+  for (size_t k = 0; k < wl.grain.size(); ++k) {
+    if (wl.grain[k] < 0 || wl.grain[k] >= n || wl.wall[k] < 0 || wl.wall[k] >= int(m.walls.size()))
+      r.fail("wall list refers to a grain or wall that does not exist (" + where("entry", k) + ")");
+    if (k > 0 && std::make_pair(wl.grain[k], wl.wall[k]) <= std::make_pair(wl.grain[k - 1], wl.wall[k - 1]))
+      r.fail("wall list is not in order (" + where("entry", k) + ")");
+  }
+  springs(wl, "wall list");
+  for (size_t w = 0; w < s.wall_on.size(); ++w)
+    if (s.wall_on[w] > 1) r.fail("wall " + std::to_string(w) + " has an invalid on/off flag");
+  // Bodies: finite states, unit orientations.
+  for (size_t b = 0; b < s.bodies.size(); ++b) {
+    const BodyState& x = s.bodies[b];
+    const std::string name = "body " + std::to_string(b) + (b < m.bodies.size() ? " ('" + m.bodies[b].name + "')" : "");
+    for (const Vec3* v : {&x.pos, &x.vel, &x.omega, &x.vel_mid, &x.omega_mid, &x.ang_mom, &x.force, &x.torque,
+                          &x.pos_at_build})
+      if (!finite(*v)) r.fail(name + " has a non-finite position, velocity, momentum or force");
+    for (const Quat* q : {&x.q, &x.q_at_build})
+      if (!finite(*q) || std::abs(q->norm() - 1) > 1e-6) r.fail(name + " has an orientation that is not a unit quaternion");
+  }
+  if (!(s.body_list_grain_disp >= 0) || !std::isfinite(s.body_list_grain_disp) || s.body_rebuilds < 0)
+    r.fail("grain–body list counters are invalid");
+  const BodyGrainList& bl = s.body_grains;
+  for (size_t k = 0; k < bl.grain.size(); ++k) {
+    if (k > 0 && std::make_tuple(bl.grain[k], bl.body[k], bl.shape[k]) <=
+                     std::make_tuple(bl.grain[k - 1], bl.body[k - 1], bl.shape[k - 1]))
+      r.fail("grain–body list is not in order (" + where("entry", k) + ")");
+    if (!(bl.sqrt_mstar[k] > 0) || !std::isfinite(bl.sqrt_mstar[k]))
+      r.fail("grain–body list holds an invalid reduced mass (" + where("entry", k) + ")");
+  }
+  springs(bl, "grain–body list");
+  for (size_t k = 0; k < bl.mesh_slots.size(); ++k) {
+    const MeshSlot& q = bl.mesh_slots[k];
+    if (!finite(q.normal) || !finite(q.spring_t) || !finite(q.spring_r) || !finite(q.spring_w) ||
+        (q.touching != 0 && q.touching != 1))
+      r.fail("grain–mesh contact history holds a non-finite value or an invalid flag (" + where("slot", k) + ")");
+  }
+  for (size_t k = 0; k < s.body_points.size(); ++k) {
+    const BodyPointContact& c = s.body_points[k];
+    if (c.a >= c.b || !finite(c.local_a) || !finite(c.local_b) || !finite(c.spring_t) || !finite(c.overlap) ||
+        !finite(c.normal) || !finite(c.point) || !finite(c.force_a))
+      r.fail("body contact " + std::to_string(k) + " holds a non-finite value or an invalid body pair");
+  }
+  // Sleep state.
+  const SleepState& z = s.sleep;
+  if (z.initialized) {
+    if (!finite(z.lo) || !std::isfinite(z.cell) || !(z.d_mean > 0) || !std::isfinite(z.d_mean) ||
+        !finite(z.gravity) || !std::isfinite(z.last_check) || z.next_check < 0)
+      r.fail("sleep state is invalid");
+    for (int i = 0; i < n; ++i)
+      if (z.asleep[i] > 1 || !finite(z.f_ref[i]) || !finite(z.f_last[i]))
+        r.fail("sleep state of grain " + std::to_string(i) + " is invalid");
+    for (double q : z.quiet)
+      if (!(q >= 0) || !std::isfinite(q)) r.fail("sleep state holds an invalid quiet time");
+  }
+  const ScheduleState& q = s.schedule;
+  for (double v : {q.dt_min, q.dt_max, q.injected, q.max_injected_fraction, q.t_start, q.v_grains, q.released})
+    if (!std::isfinite(v)) r.fail("stiffness schedule state is invalid");
+}
+
 }  // namespace
 
 void save_checkpoint(const std::string& path, const Model& m, const State& s) {
@@ -204,7 +311,7 @@ void save_checkpoint(const std::string& path, const Model& m, const State& s) {
   const uint64_t sum = fnv1a(w.buf.data(), w.buf.size());
   w.pod(sum);
 
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());  // unique per process
   std::FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) throw InputError(path + ": cannot write checkpoint");
   const bool ok = std::fwrite(w.buf.data(), 1, w.buf.size(), f) == w.buf.size() && std::fflush(f) == 0 &&
@@ -362,12 +469,7 @@ State load_checkpoint(const std::string& path, const Model& m) {
     s.free_grains_max = r.pod<int64_t>();
   }
   if (r.pos() + 8 != data.size()) r.fail("unexpected trailing data");
-  for (int p : s.pairs.partner)
-    if (p < 0 || p >= m.n_grains) r.fail("pair list refers to a grain that does not exist");
-  for (size_t k = 0; k < s.wall_pairs.grain.size(); ++k)
-    if (s.wall_pairs.grain[k] < 0 || s.wall_pairs.grain[k] >= m.n_grains || s.wall_pairs.wall[k] < 0 ||
-        s.wall_pairs.wall[k] >= int(m.walls.size()))
-      r.fail("wall list refers to a grain or wall that does not exist");
+  check_state(r, m, s);
   if (live) {
     partition_work(m, s);
     partition_body_list(m, s);

@@ -526,8 +526,9 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   m.partitions = int(rd.integer(c, "contact", "partitions", 4, 1, 256));
 
   const YAML::Node gd = rd.map(root, "", "guards", false);
-  rd.only(gd, "guards", {"max_overlap_ratio", "allow_under_resolved"});
+  rd.only(gd, "guards", {"max_overlap_ratio", "allow_under_resolved", "max_body_step_ratio"});
   m.guards.max_overlap_ratio = rd.number(gd, "guards", "max_overlap_ratio", 0.25, 0, 2, true);
+  m.guards.max_body_step_ratio = rd.number(gd, "guards", "max_body_step_ratio", 1.0, 0, 100);
   m.guards.allow_under_resolved = rd.boolean(gd, "guards", "allow_under_resolved", false);
 
   // Sleeping of quiescent regions (docs/model.md §16).
@@ -632,8 +633,9 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
           s.remove_walls.push_back(wname);
         }
       }
-      s.until_rms_speed = rd.number(st[i], p, "until_rms_speed", -1, -1, kInf);
-      s.until_max_speed = rd.number(st[i], p, "until_max_speed", -1, -1, kInf);
+      // Stop criteria: absent = off (-1 inside); given, a speed > 0.
+      s.until_rms_speed = st[i]["until_rms_speed"] ? rd.number(st[i], p, "until_rms_speed", -1, 0, kInf, true) : -1;
+      s.until_max_speed = st[i]["until_max_speed"] ? rd.number(st[i], p, "until_max_speed", -1, 0, kInf, true) : -1;
       s.check_every = rd.number(st[i], p, "check_every", 0.01, 0, kInf, true);
       if (st[i]["gravity"]) {
         s.set_gravity = true;
@@ -651,6 +653,12 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
       if (st[i]["trim_above"]) {
         s.trim = true;
         s.trim_above = rd.number(st[i], p, "trim_above", 0, -kInf, kInf);
+        // A trim plane at or below a floor (a plane wall facing up) would remove every grain.
+        for (const Wall& w : m.walls)
+          if (w.type == WallType::Plane && w.axis.z() > 1 - 1e-9 && !(s.trim_above > w.origin.z()))
+            rd.fail(p + ".trim_above", "z = " + std::to_string(s.trim_above) + " m is not above the floor" +
+                                           (w.name.empty() ? std::string() : " '" + w.name + "'") + " (z = " +
+                                           std::to_string(w.origin.z()) + " m): the trim would remove every grain");
       }
       sc.stages.push_back(s);
     }

@@ -36,7 +36,7 @@ void write_snapshot(const std::string& path, const Model& m, const State& s, boo
   }
   const uint64_t sum = fnv1a(buf.data(), buf.size());
   buf.append(reinterpret_cast<const char*>(&sum), sizeof sum);
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());  // unique per process
   std::FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) throw InputError(path + ": cannot write snapshot");
   const bool ok = std::fwrite(buf.data(), 1, buf.size(), f) == buf.size() && std::fflush(f) == 0 &&

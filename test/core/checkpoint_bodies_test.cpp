@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <random>
 #include <string>
@@ -272,6 +273,68 @@ TEST(CheckpointBodies, DamagedFilesAreRefused) {
     bad[at] = char(bad[at] ^ 0x10);
     const std::string msg = refusal(bad);
     EXPECT_NE(msg.find("corrupted"), std::string::npos) << "flip at " << at << ": " << msg;
+  }
+  std::remove(path.c_str());
+}
+
+// A file that passes its checksum but holds a state no step could take (a
+// non-finite number, an index out of range, a list out of order) is refused
+// with its path and what is wrong, never loaded (a NaN position used to
+// reach the cell grid, an out-of-range row the force pass).
+TEST(CheckpointBodies, ValidFilesWithUnusableStatesAreRefused) {
+  omp_set_num_threads(1);
+  Scene sc = make_scene(200);
+  for (int k = 0; k < 300; ++k) rt::step(sc.m, sc.s);
+  const rt::State& good = sc.s;
+  ASSERT_GT(good.pairs.size(), 10);
+  ASSERT_GT(good.wall_pairs.size(), 1);
+  ASSERT_GT(good.body_grains.size(), 1);
+  ASSERT_FALSE(good.body_points.empty());
+  const std::string path = temp_path("unusable.ckpt");
+  rt::save_checkpoint(path, sc.m, good);
+  EXPECT_NO_THROW(rt::load_checkpoint(path, sc.m));
+  const double nan = std::nan(""), inf = HUGE_VAL;
+  int row = 0;  // a grain with at least two partners
+  while (good.pairs.row_start[row + 1] - good.pairs.row_start[row] < 2) ++row;
+  const int k0 = good.pairs.row_start[row];
+  size_t w0 = 0;  // two wall entries of different grains
+  while (good.wall_pairs.grain[w0] == good.wall_pairs.grain[w0 + 1]) ++w0;
+  struct Case {
+    const char* expect;
+    std::function<void(rt::State&)> damage;
+  };
+  const std::vector<Case> cases = {
+      {"grain 7 has a non-finite position", [&](rt::State& s) { s.pos[7].y() = nan; }},
+      {"grain 3 has a non-finite velocity", [&](rt::State& s) { s.vel[3].z() = inf; }},
+      {"grain 5 has a non-finite angular velocity", [&](rt::State& s) { s.omega[5].x() = -inf; }},
+      {"clock or step counters", [&](rt::State& s) { s.time = nan; }},
+      {"pair list rows", [&](rt::State& s) { s.pairs.row_start.back() += 1000; }},
+      {"pair list rows are not in order", [&](rt::State& s) { s.pairs.row_start[row + 1] = s.pairs.row_start[row] - 1; }},
+      {"out of order", [&](rt::State& s) { std::swap(s.pairs.partner[k0], s.pairs.partner[k0 + 1]); }},
+      {"does not exist", [&](rt::State& s) { s.pairs.partner[k0] = 1 << 30; }},
+      {"pair list holds a non-finite spring", [&](rt::State& s) { s.pairs.spring_t[k0].x() = nan; }},
+      {"invalid contact flag", [&](rt::State& s) { s.pairs.touching[k0] = 7; }},
+      {"wall list refers to a grain or wall", [&](rt::State& s) { s.wall_pairs.wall[0] = 99; }},
+      {"wall list is not in order", [&](rt::State& s) { std::swap(s.wall_pairs.grain[w0], s.wall_pairs.grain[w0 + 1]); }},
+      {"body 1 ('box_a') has a non-finite", [&](rt::State& s) { s.bodies[1].vel.x() = nan; }},
+      {"body 2 ('box_b') has an orientation", [&](rt::State& s) { s.bodies[2].q.coeffs() *= 1.5; }},
+      {"grain–body list is not in order",
+       [&](rt::State& s) { std::swap(s.body_grains.grain[0], s.body_grains.grain.back()); }},
+      {"invalid reduced mass", [&](rt::State& s) { s.body_grains.sqrt_mstar[0] = -1; }},
+      {"body contact 0 holds a non-finite value", [&](rt::State& s) { s.body_points[0].point.z() = nan; }},
+  };
+  for (const Case& c : cases) {
+    rt::State bad = good;
+    c.damage(bad);
+    rt::save_checkpoint(path, sc.m, bad);  // a valid file (checksum and all) of a bad state
+    std::string msg = "(accepted)";
+    try {
+      rt::load_checkpoint(path, sc.m);
+    } catch (const rt::InputError& e) {
+      msg = e.what();
+    }
+    EXPECT_NE(msg.find(path), std::string::npos) << c.expect << ": " << msg;
+    EXPECT_NE(msg.find(c.expect), std::string::npos) << msg;
   }
   std::remove(path.c_str());
 }

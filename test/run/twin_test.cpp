@@ -3,6 +3,7 @@
 // same prepared scene, and reset and checkpoints restore states exactly.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <unistd.h>
@@ -73,4 +74,32 @@ TEST(Twin, ResetAndCheckpointsRestoreExactly) {
   EXPECT_EQ(twin.state().bodies[b].pos, p0);
   EXPECT_EQ(twin.state().time, 0.0);
   std::remove(path.c_str());
+}
+
+TEST(Twin, ANonFiniteBodyStateIsRefusedAndChangesNothing) {
+  rt::Twin twin(options());
+  const int b = static_cast<const rt::LandingScene&>(twin.scene()).lander;
+  for (int k = 0; k < 20; ++k) twin.step();
+  const rt::BodyState before = twin.state().bodies[b];
+  const double nan = std::nan(""), inf = HUGE_VAL;
+  const rt::Vec3 p = before.pos, z = rt::Vec3::Zero();
+  const rt::Quat q = rt::Quat::Identity();
+  struct Case {
+    rt::Vec3 pos, vel, omega;
+    rt::Quat q;
+  };
+  for (const Case& c : {Case{rt::Vec3(nan, 0, 0), z, z, q}, Case{p, rt::Vec3(0, inf, 0), z, q},
+                        Case{p, z, rt::Vec3(0, 0, nan), q}, Case{p, z, z, rt::Quat(nan, 0, 0, 0)},
+                        Case{p, z, z, rt::Quat(0, 0, 0, 0)}}) {
+    try {
+      twin.set_body_state(b, c.pos, c.q, c.vel, c.omega);
+      ADD_FAILURE() << "a non-finite body state was accepted";
+    } catch (const rt::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("must be finite"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(twin.state().bodies[b].pos, before.pos);
+    EXPECT_EQ(twin.state().bodies[b].vel, before.vel);
+  }
+  twin.step();  // and the twin steps on
+  EXPECT_TRUE(twin.state().bodies[b].pos.allFinite());
 }

@@ -4,6 +4,7 @@
 // diagnostic naming step and time, and readable outputs; the command-line
 // tool reports both with its documented exit codes.
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
@@ -18,6 +19,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "regolith_twin/run/series.hpp"
@@ -138,6 +140,19 @@ TEST_F(ScenarioInput, MissingStagesAreRefused) {
                  {"stages", "missing", "duration"});
   expect_refused("zero_duration.yaml", replaced(kBase, "duration: 0.2", "duration: 0"),
                  {"stages[0].duration", "(0, "});
+}
+
+TEST_F(ScenarioInput, NonsenseStageValuesAreRefused) {
+  // Negative stop criteria (they would never stop a stage, or stop it at once).
+  expect_refused("negative_rms.yaml", replaced(kBase, "duration: 0.2}", "duration: 0.2, until_rms_speed: -0.5}"),
+                 {"stages[0].until_rms_speed", "-0.5", "out of range"});
+  expect_refused("zero_max.yaml", replaced(kBase, "duration: 0.2}", "duration: 0.2, until_max_speed: 0}"),
+                 {"stages[0].until_max_speed", "out of range"});
+  // A trim plane at or below the floor would remove every grain.
+  expect_refused("trim_below.yaml", replaced(kBase, "duration: 0.2}", "duration: 0.2, trim_above: -0.1}"),
+                 {"stages[0].trim_above", "not above the floor", "remove every grain"});
+  // Above the floor it is accepted.
+  EXPECT_NO_THROW(rt::load_scenario(write("trim_ok.yaml", replaced(kBase, "duration: 0.2}", "duration: 0.2, trim_above: 0.04}"))));
 }
 
 TEST_F(ScenarioInput, InvalidYamlIsRefused) {
@@ -442,6 +457,59 @@ TEST_F(ScenarioInput, CommandLineToolReportsBadInputWithExitCode2) {
   EXPECT_NE(out.find("no_such_file.yaml"), std::string::npos) << out;
   EXPECT_EQ(run_command("'" + sim + "' '" + bad + "' --threads zero", &out), 2) << out;
   EXPECT_NE(out.find("--threads"), std::string::npos) << out;
+}
+
+TEST_F(ScenarioInput, OneRunPerOutputFolderAndPathsCheckedBeforeTheRun) {
+  const std::string sim = sim_path();
+  ASSERT_EQ(access(sim.c_str(), X_OK), 0) << sim << " not found";
+  // A run long enough to be running while a second one is started into its folder.
+  const std::string slow = write("cli_slow.yaml", replaced(kBase, "duration: 0.2", "duration: 1000"));
+  const std::string out_dir = dir_ + "/shared_out";
+  rt::make_dirs(out_dir);
+  std::ofstream(out_dir + "/summary.json") << "{\"status\": \"ok\"}\n";  // an earlier run's summary
+  const std::string pid_file = dir_ + "/slow.pid";
+  ASSERT_EQ(std::system(("'" + sim + "' '" + slow + "' --quiet --threads 1 --out '" + out_dir +
+                         "' >/dev/null 2>&1 & echo $! > '" + pid_file + "'").c_str()),
+            0);
+  long pid = 0;
+  for (int k = 0; k < 200 && pid == 0; ++k) {
+    usleep(20000);
+    std::ifstream(pid_file) >> pid;
+  }
+  ASSERT_GT(pid, 0);
+  struct Killer {  // the slow run never outlives the test
+    long pid;
+    ~Killer() { ::kill(pid_t(pid), SIGKILL); }
+  } killer{pid};
+  // The folder is taken once the first run has written its lock.
+  std::string lock;
+  for (int k = 0; k < 500 && lock.find('\n') == std::string::npos; ++k) {
+    usleep(20000);
+    lock = slurp(out_dir + "/.regolith_twin.lock");
+  }
+  EXPECT_EQ(lock, std::to_string(pid) + "\n");
+  EXPECT_NE(access((out_dir + "/summary.json").c_str(), F_OK), 0) << "the earlier run's summary is still there";
+  std::string out;
+  EXPECT_EQ(run_command("'" + sim + "' '" + write("cli_quick.yaml", kBase) + "' --quiet --out '" + out_dir + "'", &out), 2)
+      << out;
+  EXPECT_NE(out.find(out_dir + ": the output folder is in use by another run (pid " + std::to_string(pid) + ")"),
+            std::string::npos)
+      << out;
+  ::kill(pid_t(pid), SIGKILL);  // the lock ends with its process, even killed
+  for (int k = 0; k < 200 && ::kill(pid_t(pid), 0) == 0; ++k) usleep(20000);
+  const std::string quick = write("cli_quick2.yaml", replaced(kBase, "duration: 0.2", "duration: 0.002"));
+  EXPECT_EQ(run_command("'" + sim + "' '" + quick + "' --quiet --threads 1 --out '" + out_dir + "'", &out), 0) << out;
+  EXPECT_EQ(access((out_dir + "/summary.json").c_str(), F_OK), 0);
+  // Output paths that cannot be written are refused before the run, not after it.
+  write("a_file", "x");
+  const std::pair<std::string, std::string> bad_paths[] = {
+      {"--out '" + dir_ + "/a_file/sub'", dir_ + "/a_file/sub: cannot"},
+      {"--out '" + dir_ + "/o2' --checkpoint '" + dir_ + "/no_dir/end.ckpt'", dir_ + "/no_dir/end.ckpt: cannot be written"},
+      {"--out '" + dir_ + "/o3' --snapshot '" + dir_ + "/no_dir/end.bed'", dir_ + "/no_dir/end.bed: cannot be written"}};
+  for (const auto& [args, expect] : bad_paths) {
+    EXPECT_EQ(run_command("'" + sim + "' '" + slow + "' --quiet " + args, &out), 2) << args << ": " << out;
+    EXPECT_NE(out.find(expect), std::string::npos) << args << ": " << out;
+  }
 }
 
 TEST_F(ScenarioInput, ProfileKeysComeBeforeTheCommandLinesOwn) {

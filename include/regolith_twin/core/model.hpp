@@ -137,6 +137,8 @@ struct Guards {
   double min_steps_per_contact_warn = 10;
   double min_steps_per_contact_refuse = 4;
   bool allow_under_resolved = false;
+  // A free body may move at most this fraction of body_step_limit (docs/model.md §13) in one step (<= 0: off).
+  double max_body_step_ratio = 1.0;
 };
 
 // Bullet collision objects of the bodies' shapes (defined in body_collision.cpp).
@@ -180,6 +182,7 @@ struct Model {
   double dt = 1e-5;                    // s
   double kn = 0;                       // scene normal stiffness of the linear law, N/m
   double skin = 0;                     // neighbour-list skin, m (<= 0: chosen by finalize_model)
+  double body_step_limit = 0;          // largest safe drift of a body point in one step, m (finalize_model; 0: none)
   int partitions = 4;                  // fixed work partitions of the force pass: results are
                                        // bit-identical for any thread count <= partitions
   int parallel_min_grains = 3000;      // smaller scenes run on one thread (same result)

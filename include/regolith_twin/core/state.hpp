@@ -123,6 +123,9 @@ struct StepStats {
   long body_contacts = 0;        // grain–body contacts with overlap > 0
   long body_body_contacts = 0;   // body–body contact points
   bool finite = true;            // every velocity finite after the last kick
+  int bad_body = -1;             // a free body whose state became non-finite (-1: none)
+  double max_body_step = 0;      // largest displacement of a point of a free body in the last drift, m
+  int max_body_step_body = -1;   // the body of that displacement
   double max_disp2 = 0;          // squared max displacement since the last list build, m^2
                                  // (with free flight: of the grains without a reach)
   double max_free_disp2 = 0;     // free flight: squared max displacement of the grains with a reach, m^2

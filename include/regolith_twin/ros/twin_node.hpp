@@ -26,6 +26,7 @@
 #include "regolith_twin/SetBodyState.h"
 #include "regolith_twin/Step.h"
 #include "regolith_twin/ros/scene_topics.hpp"
+#include "regolith_twin/run/series.hpp"
 #include "regolith_twin/run/twin.hpp"
 
 namespace rt_ros {
@@ -96,6 +97,7 @@ class TwinNode {
 
   ros::NodeHandle nh_, pnh_;
   NodeParams p_;
+  std::unique_ptr<rt::OutputFolder> out_folder_;  // ~out_dir, held for the node's life
   std::unique_ptr<rt::Twin> twin_;
   std::unique_ptr<SceneTopics> topics_;  // the scene kind's own topics
   std::mutex mu_;

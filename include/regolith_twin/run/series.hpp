@@ -13,6 +13,33 @@ namespace rt {
 // folder if it does not exist afterwards.
 void make_dirs(const std::string& dir);
 
+// One run per output folder (docs/architecture.md, outputs): creates the
+// folder, takes an exclusive lock on DIR/.regolith_twin.lock for the
+// object's lifetime and removes the summary.json of an earlier run, so a
+// folder never holds a finished-looking summary beside a new run's partial
+// series. Throws InputError naming the folder when it cannot be written or
+// another live process holds it (the lock ends with that process, even when
+// it is killed).
+class OutputFolder {
+ public:
+  explicit OutputFolder(const std::string& dir);
+  ~OutputFolder();
+  OutputFolder(const OutputFolder&) = delete;
+  OutputFolder& operator=(const OutputFolder&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+// Throws InputError naming `path` unless a file can be created beside it
+// (a probe created and removed at once): checks an output path before a
+// long run rather than at its end.
+void check_writable(const std::string& path);
+
+// A temporary name beside `path`, unique to this process (written, then
+// renamed over `path`).
+std::string temp_name(const std::string& path);
+
 class CsvSeries {
  public:
   CsvSeries() = default;

@@ -24,6 +24,7 @@
 #include "regolith_twin/Status.h"
 #include "regolith_twin/core/energy.hpp"
 #include "regolith_twin/run/series.hpp"
+#include "regolith_twin/scene/checkpoint.hpp"
 
 namespace rt_ros {
 namespace {
@@ -120,6 +121,7 @@ NodeParams read_params(const ros::NodeHandle& pnh) {
   p.shutdown_at_end = param_bool(pnh, "shutdown_at_end", false);
   p.wait_for_recorder = param_bool(pnh, "wait_for_recorder", false);
   p.threads = int(param_number(pnh, "threads", 0, 0, 256));
+  p.max_step_wall = param_number(pnh, "max_step_wall", 600, 1e-3, 1e7);
   return p;
 }
 
@@ -707,6 +709,13 @@ bool TwinNode::on_pause(std_srvs::Trigger::Request&, std_srvs::Trigger::Response
   paused_ = true;
   res.success = true;
   res.message = "paused at t = " + std::to_string(twin_->state().time) + " s";
+  if (pending_steps_ > 0) {  // a ~step in progress stops here and answers that it was cancelled
+    pending_steps_ = 0;
+    pending_until_ = -1;
+    step_cancelled_ = true;
+    step_cv_.notify_all();
+    res.message += "; the ~step request in progress was cancelled";
+  }
   return true;
 }
 
@@ -763,22 +772,46 @@ bool TwinNode::on_step(regolith_twin::Step::Request& req, regolith_twin::Step::R
   } else {
     pending_steps_ = by_time ? 1 : req.steps;  // by time: one pending until the span is done
     pending_until_ = by_time ? twin_->state().time + req.duration : -1;
+    step_cancelled_ = false;
     cv_.notify_all();
-    step_cv_.wait(lk, [&] { return pending_steps_ == 0 || !running_; });
-    res.success = !failed_ && running_;
-    res.message = failed_ ? failure_ : (running_ ? "ok" : "node stopping");
+    // Bounded: ~pause cancels it, and so does ~max_step_wall seconds of wall time.
+    const bool done = step_cv_.wait_for(lk, std::chrono::duration<double>(p_.max_step_wall),
+                                        [&] { return pending_steps_ == 0 || !running_; });
+    if (!done) {
+      pending_steps_ = 0;
+      pending_until_ = -1;
+      res.success = false;
+      res.message = "stopped after " + std::to_string(p_.max_step_wall) +
+                    " s of wall time (~max_step_wall); ask for fewer steps or raise ~max_step_wall";
+    } else if (step_cancelled_) {
+      res.success = false;
+      res.message = "cancelled by ~pause";
+    } else {
+      res.success = !failed_ && running_;
+      res.message = failed_ ? failure_ : (running_ ? "ok" : "node stopping");
+    }
+    step_cancelled_ = false;
   }
   res.sim_time = twin_->state().time;
   return true;
 }
 
+// Checkpoints: the state is copied to bytes (save) or made from bytes (load)
+// under the simulation lock; the file is written or read outside it, so a
+// slow or blocking path never stops /clock or the other services.
 bool TwinNode::on_save(regolith_twin::Checkpoint::Request& req, regolith_twin::Checkpoint::Response& res) {
-  std::lock_guard<std::mutex> lk(mu_);
   try {
     if (req.path.empty()) throw rt::InputError("path is empty");
-    twin_->save(req.path);
+    std::string image;
+    double t = 0;
+    {
+      std::lock_guard<std::mutex> lk(mu_);
+      image = twin_->checkpoint_image();
+      t = twin_->state().time;
+    }
+    rt::write_checkpoint_file(req.path, image);
     res.success = true;
-    res.message = "saved t = " + std::to_string(twin_->state().time) + " s to " + req.path;
+    res.message = "saved t = " + std::to_string(t) + " s to " + req.path;
   } catch (const std::exception& e) {
     res.success = false;
     res.message = e.what();
@@ -787,10 +820,11 @@ bool TwinNode::on_save(regolith_twin::Checkpoint::Request& req, regolith_twin::C
 }
 
 bool TwinNode::on_load(regolith_twin::Checkpoint::Request& req, regolith_twin::Checkpoint::Response& res) {
-  std::lock_guard<std::mutex> lk(mu_);
   try {
     if (!std::ifstream(req.path).good()) throw rt::InputError(req.path + ": cannot read the file");
-    twin_->load(req.path);
+    const std::string data = rt::read_checkpoint_file(req.path);
+    std::lock_guard<std::mutex> lk(mu_);
+    twin_->load_image(req.path, data);
     failed_ = false;
     failure_.clear();
     end_handled_ = false;

@@ -132,8 +132,12 @@ void Twin::apply_wrench(int b, const Vec3& force, const Vec3& torque, double unt
 
 void Twin::save(const std::string& path) const { save_checkpoint(path, model_, state_); }
 
-void Twin::load(const std::string& path) {
-  State loaded = load_checkpoint(path, scene_->sc.model);
+std::string Twin::checkpoint_image() const { return rt::checkpoint_image(model_, state_); }
+
+void Twin::load(const std::string& path) { load_image(path, read_checkpoint_file(path)); }
+
+void Twin::load_image(const std::string& source, const std::string& data) {
+  State loaded = state_from_checkpoint(source, data, scene_->sc.model);
   scene_run_.reset();
   run_.reset();
   model_ = scene_->sc.model;

@@ -226,6 +226,14 @@ void check_state(Reader& r, const Model& m, const State& s) {
 }  // namespace
 
 void save_checkpoint(const std::string& path, const Model& m, const State& s) {
+  write_checkpoint_file(path, checkpoint_image(m, s));
+}
+
+State load_checkpoint(const std::string& path, const Model& m) {
+  return state_from_checkpoint(path, read_checkpoint_file(path), m);
+}
+
+std::string checkpoint_image(const Model& m, const State& s) {
   Writer w;
   w.raw(kMagic, sizeof kMagic);
   w.pod(kVersion);
@@ -310,11 +318,14 @@ void save_checkpoint(const std::string& path, const Model& m, const State& s) {
   w.pod<int64_t>(s.free_grains_max);
   const uint64_t sum = fnv1a(w.buf.data(), w.buf.size());
   w.pod(sum);
+  return std::move(w.buf);
+}
 
+void write_checkpoint_file(const std::string& path, const std::string& image) {
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());  // unique per process
   std::FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) throw InputError(path + ": cannot write checkpoint");
-  const bool ok = std::fwrite(w.buf.data(), 1, w.buf.size(), f) == w.buf.size() && std::fflush(f) == 0 &&
+  const bool ok = std::fwrite(image.data(), 1, image.size(), f) == image.size() && std::fflush(f) == 0 &&
                   ::fsync(fileno(f)) == 0;
   if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
     std::remove(tmp.c_str());
@@ -322,12 +333,16 @@ void save_checkpoint(const std::string& path, const Model& m, const State& s) {
   }
 }
 
-State load_checkpoint(const std::string& path, const Model& m) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
+std::string read_checkpoint_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open checkpoint");
-  std::string data(static_cast<size_t>(in.tellg()), '\0');
-  in.seekg(0);
-  if (!in.read(data.data(), data.size())) throw InputError(path + ": cannot read checkpoint");
+  // Read to the end (a pipe or special file has no size to ask for).
+  std::string data(std::istreambuf_iterator<char>(in), {});
+  if (in.bad()) throw InputError(path + ": cannot read checkpoint");
+  return data;
+}
+
+State state_from_checkpoint(const std::string& path, const std::string& data, const Model& m) {
   Reader r(path, data);
   const size_t head = std::min(data.size(), sizeof kMagic);
   if (std::memcmp(data.data(), kMagic, head) != 0 || data.empty()) r.fail("wrong file type (no checkpoint header)");

@@ -7,10 +7,16 @@
 #include <ros/ros.h>
 #include <std_srvs/Trigger.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
 #include <cstdio>
 #include <memory>
 #include <mutex>
-#include <unistd.h>
+#include <string>
+#include <thread>
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -268,6 +274,67 @@ TEST(TwinNodeServices, BadRequestsGetErrors_AndTheNodeGoesOn) {
   const auto r = step(2);
   EXPECT_TRUE(r.success);
   EXPECT_GT(r.sim_time, t);
+}
+
+TEST(TwinNodeServices, ALongStepIsCancelledByPause) {
+  ASSERT_TRUE(trigger("pause"));
+  const double t0 = g_node->sim_time();
+  regolith_twin::Step::Response r;
+  std::thread caller([&r] {
+    regolith_twin::Step s;
+    s.request.steps = 100000000;  // far longer than the test
+    EXPECT_TRUE(ros::service::call(srv("step"), s));
+    r = s.response;
+  });
+  ros::WallDuration(1.0).sleep();
+  std::string msg;
+  EXPECT_TRUE(trigger("pause", &msg));
+  EXPECT_NE(msg.find("cancelled"), std::string::npos) << msg;
+  caller.join();  // the step request answers at once
+  EXPECT_FALSE(r.success);
+  EXPECT_EQ(r.message, "cancelled by ~pause");
+  EXPECT_GT(r.sim_time, t0);
+  // The twin is paused where the request stopped, and steps on request.
+  const double t1 = g_node->sim_time();
+  ros::WallDuration(0.2).sleep();
+  EXPECT_EQ(g_node->sim_time(), t1);
+  EXPECT_TRUE(step(3).success);
+}
+
+TEST(TwinNodeServices, ABlockingCheckpointPathDoesNotStopTheNode) {
+  // A named pipe nobody writes to: opening it blocks. The load waits
+  // outside the simulation lock, so the node steps and answers meanwhile.
+  ASSERT_TRUE(trigger("pause"));
+  char dir[] = "/tmp/regolith_fifo_XXXXXX";
+  ASSERT_NE(mkdtemp(dir), nullptr);
+  const std::string fifo = std::string(dir) + "/state.ckpt";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  regolith_twin::Checkpoint c;
+  c.request.path = fifo;
+  std::atomic<bool> answered{false};
+  std::thread loader([&] {
+    EXPECT_TRUE(ros::service::call(srv("load_checkpoint"), c));
+    answered = true;
+  });
+  ros::WallDuration(0.5).sleep();
+  EXPECT_FALSE(answered);
+  const double t = g_node->sim_time();
+  const auto r = step(5);  // served while the load waits
+  EXPECT_TRUE(r.success) << r.message;
+  EXPECT_GT(r.sim_time, t);
+  EXPECT_TRUE(trigger("pause"));
+  // Writers come and go with nothing written: the load reads an empty file and refuses it.
+  for (int k = 0; k < 1000 && !answered; ++k) {
+    const int fd = open(fifo.c_str(), O_WRONLY | O_NONBLOCK);  // succeeds only while a reader waits
+    if (fd >= 0) close(fd);
+    ros::WallDuration(0.01).sleep();
+  }
+  loader.join();
+  EXPECT_FALSE(c.response.success);
+  EXPECT_NE(c.response.message.find(fifo), std::string::npos) << c.response.message;
+  std::remove(fifo.c_str());
+  rmdir(dir);
+  EXPECT_TRUE(step(2).success);
 }
 
 int main(int argc, char** argv) {

@@ -51,6 +51,7 @@ struct NodeParams {
   bool wait_for_recorder = false;     // ~wait_for_recorder: start stepping only once ~body_states and
                                       //   ~status have a subscriber (a rosbag recorder) and 1 s has passed
   int threads = 0;                    // ~threads: OpenMP threads (0: all cores)
+  double max_step_wall = 600;         // ~max_step_wall: wall seconds a ~step request may take before it is stopped
 };
 
 // Throws std::invalid_argument naming the parameter and its allowed range.
@@ -106,6 +107,7 @@ class TwinNode {
   bool paused_ = false;
   long pending_steps_ = 0;
   double pending_until_ = -1;  // a ~step by duration: simulated time it ends at (-1: by count)
+  bool step_cancelled_ = false;  // the ~step in progress was cancelled by ~pause
   bool failed_ = false;              // a blow-up stopped the run
   std::string failure_;
   std::atomic<bool> running_{false};

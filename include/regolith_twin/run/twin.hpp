@@ -68,6 +68,10 @@ class Twin {
   // The whole evolving state. A loaded state restarts the run's observers from it.
   void save(const std::string& path) const;
   void load(const std::string& path);
+  // The same without the file: the checkpoint's bytes, and loading from
+  // bytes read elsewhere (`source` names them in errors).
+  std::string checkpoint_image() const;
+  void load_image(const std::string& source, const std::string& data);
 
  private:
   void restart_run();

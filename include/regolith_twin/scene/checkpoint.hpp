@@ -14,7 +14,16 @@ void save_checkpoint(const std::string& path, const Model& m, const State& s);
 
 // Read a checkpoint written for the same model (grain count, radii and
 // materials must match). Throws InputError naming the file on a wrong,
-// truncated or corrupted file.
+// truncated or corrupted file, or one whose state could not be stepped.
 State load_checkpoint(const std::string& path, const Model& m);
+
+// The same in two halves, so a caller can keep file I/O apart from the
+// state (the node holds its simulation lock only for the in-memory halves):
+// the bytes of a checkpoint of s; writing bytes to path atomically; reading
+// a file's bytes; a state from bytes (`path` names the source in errors).
+std::string checkpoint_image(const Model& m, const State& s);
+void write_checkpoint_file(const std::string& path, const std::string& image);
+std::string read_checkpoint_file(const std::string& path);
+State state_from_checkpoint(const std::string& path, const std::string& data, const Model& m);
 
 }  // namespace rt

@@ -175,21 +175,6 @@ void expect_steps_allocate_nothing(int threads, int parallel_min_grains, bool fr
 
 namespace {
 
-rt::BodyModel box_body(const std::string& name, const Vec3& half, bool fixed) {
-  rt::BodyModel b;
-  b.name = name;
-  b.fixed = fixed;
-  b.material = 1;
-  b.mass = 8 * half.prod() * 2000;
-  b.inertia = b.mass / 3 *
-              Vec3(half.y() * half.y() + half.z() * half.z(), half.x() * half.x() + half.z() * half.z(),
-                   half.x() * half.x() + half.y() * half.y());
-  rt::Shape sh;
-  sh.type = rt::ShapeType::Box;
-  sh.size = half;
-  b.shapes.push_back(sh);
-  return b;
-}
 
 // 1200 'moderate' grains thrown down between four plane walls onto a fixed
 // plate body, around a free box sliding and spinning on the plate and a
@@ -216,9 +201,9 @@ Scene make_body_scene(int parallel_min_grains, MeshVariant mesh = kNoMesh) {
   m.walls.push_back(rt::make_plane(Vec3(0, -L, 0), Vec3::UnitY(), 1));
   m.walls.push_back(rt::make_plane(Vec3(0, L, 0), -Vec3::UnitY(), 1));
   const Vec3 half_a(0.03, 0.025, 0.015), half_b(0.012, 0.012, 0.01);
-  m.bodies.push_back(box_body("plate", Vec3(0.1, 0.1, 0.01), true));
-  m.bodies.push_back(box_body("box_a", half_a, false));
-  m.bodies.push_back(box_body("box_b", half_b, false));
+  m.bodies.push_back(rt::test::box_body("plate", Vec3(0.1, 0.1, 0.01), 2000, true, 1));
+  m.bodies.push_back(rt::test::box_body("box_a", half_a, 2000, false, 1));
+  m.bodies.push_back(rt::test::box_body("box_b", half_b, 2000, false, 1));
   if (mesh != kNoMesh) {
     const int keep = mesh == kFixedMeshPlate ? 0 : 1;
     rt::BodyModel b = m.bodies[keep];

@@ -13,26 +13,7 @@
 
 namespace {
 
-using rt::BodyModel;
-using rt::Shape;
-using rt::ShapeType;
 using rt::Vec3;
-
-BodyModel box(const std::string& name, const Vec3& half, bool fixed) {
-  BodyModel b;
-  b.name = name;
-  b.fixed = fixed;
-  b.material = 0;
-  b.mass = 8 * half.prod() * 2000;
-  b.inertia = b.mass / 3 *
-              Vec3(half.y() * half.y() + half.z() * half.z(), half.x() * half.x() + half.z() * half.z(),
-                   half.x() * half.x() + half.y() * half.y());
-  Shape sh;
-  sh.type = ShapeType::Box;
-  sh.size = half;
-  b.shapes.push_back(sh);
-  return b;
-}
 
 // A 2 cm cube falling at `speed` onto a fixed plate 1 mm thick (top face at
 // z = 0), no gravity, no grains. The plate's half thickness (0.5 mm) is the
@@ -47,8 +28,8 @@ PlateScene plate_scene(double speed, double dt, double ratio) {
   rt::Material mat = rt::test::simple_material("structure", 2000, 0.5, 0.5, 0.5);
   mat.structure = true;
   p.m.materials.push_back(mat);
-  p.m.bodies.push_back(box("plate", Vec3(0.1, 0.1, 5e-4), true));
-  p.m.bodies.push_back(box("cube", Vec3(0.01, 0.01, 0.01), false));
+  p.m.bodies.push_back(rt::test::box_body("plate", Vec3(0.1, 0.1, 5e-4), 2000, true, 0));
+  p.m.bodies.push_back(rt::test::box_body("cube", Vec3(0.01, 0.01, 0.01), 2000, false, 0));
   p.m.kn = 1e6;
   p.m.dt = dt;
   p.m.gravity = Vec3::Zero();

@@ -30,27 +30,11 @@ namespace {
 
 using rt::BodyModel;
 using rt::Quat;
-using rt::Shape;
-using rt::ShapeType;
 using rt::Vec3;
 
 constexpr double kPi = 3.14159265358979323846;
 
-BodyModel box_body(const std::string& name, const Vec3& half, double density, bool fixed, int material) {
-  BodyModel b;
-  b.name = name;
-  b.fixed = fixed;
-  b.material = material;
-  b.mass = 8 * half.prod() * density;
-  b.inertia = b.mass / 3 *
-              Vec3(half.y() * half.y() + half.z() * half.z(), half.x() * half.x() + half.z() * half.z(),
-                   half.x() * half.x() + half.y() * half.y());
-  Shape sh;
-  sh.type = ShapeType::Box;
-  sh.size = half;
-  b.shapes.push_back(sh);
-  return b;
-}
+using rt::test::box_body;
 
 struct Scene {
   rt::Model m;

@@ -100,4 +100,20 @@ TriangleMesh box_mesh(const Vec3& lo, const Vec3& hi, int n) {
   return m;
 }
 
+BodyModel box_body(const std::string& name, const Vec3& half, double density, bool fixed, int material) {
+  BodyModel b;
+  b.name = name;
+  b.fixed = fixed;
+  b.material = material;
+  b.mass = 8 * half.prod() * density;
+  b.inertia = b.mass / 3 *
+              Vec3(half.y() * half.y() + half.z() * half.z(), half.x() * half.x() + half.z() * half.z(),
+                   half.x() * half.x() + half.y() * half.y());
+  Shape sh;
+  sh.type = ShapeType::Box;
+  sh.size = half;
+  b.shapes.push_back(sh);
+  return b;
+}
+
 }  // namespace rt::test

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "regolith_twin/core/body.hpp"
 #include "regolith_twin/core/energy.hpp"
 #include "regolith_twin/core/model.hpp"
 #include "regolith_twin/core/state.hpp"
@@ -24,6 +25,10 @@ void grain_and_wall_in_open_box(Model& m, double side);
 // A published preset (grains, material 0) and the same material as a
 // structure named `wall` (material 1); false if the preset is unknown.
 bool preset_with_wall(Model& m, const std::string& preset);
+
+// A body of one box shape of half extents `half` centred on its centre of
+// mass, of the given density (mass and principal inertia from them).
+BodyModel box_body(const std::string& name, const Vec3& half, double density, bool fixed, int material);
 
 // The closed box [lo, hi] as a triangle mesh, each face cut into n x n
 // cells of two triangles, wound outwards (vertices shared within a face).

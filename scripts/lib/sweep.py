@@ -303,6 +303,8 @@ def sweep(a, grid, land):
                        started=time.strftime("%Y-%m-%d %H:%M:%S")), f, indent=1)
     done_before = total - len(todo)
     print(f"sweep: {total} runs in {a.out}/runs ({done_before} already done, {len(todo)} to run)", flush=True)
+    if a.slurm:
+        return slurm_sweep(a, grid, todo)
     walls, failed = [], []
     jobs = max(1, min(a.jobs, len(todo)))
 
@@ -341,6 +343,74 @@ def sweep(a, grid, land):
         raise
     pool.shutdown(wait=True)
     return failed
+
+
+# ---------------------------------------------------------------- Slurm
+
+def slurm_wait(job, poll):
+    """Until the job (array) has left the queue."""
+    while True:
+        q = subprocess.run(["squeue", "-h", "-j", job, "-o", "%i %t"], capture_output=True, text=True)
+        if q.returncode != 0 and "Invalid job id" not in q.stderr:
+            fail(f"squeue failed: {q.stderr.strip()}", 1)
+        if not q.stdout.strip():
+            return
+        time.sleep(poll)
+
+
+def slurm_sweep(a, grid, todo):
+    """The runs to do as Slurm job arrays, one run per task, into the shared
+    output folder. A failed task (Slurm does not retry array tasks by itself)
+    is resubmitted up to --slurm-retries times; finished runs are never
+    submitted again. Returns the names of the runs still failed."""
+    sdir = os.path.join(a.out, "slurm")
+    os.makedirs(sdir, exist_ok=True)
+    index = {run_name(*p): k for k, p in enumerate(grid)}
+    pending = [index[run_name(*p)] for _, p in todo]
+    for attempt in range(1, a.slurm_retries + 2):
+        pending = [k for k in pending if not is_done(os.path.join(a.out, "runs", run_name(*grid[k])))]
+        if not pending:
+            break
+        batch = os.path.join(sdir, f"batch_{time.strftime('%Y%m%d_%H%M%S')}_{attempt}.json")
+        with open(batch, "w") as f:
+            json.dump({"argv": a.argv, "points": pending}, f, indent=1)
+        cmd = ["sbatch", "--parsable", f"--array=0-{len(pending) - 1}", "--job-name=regolith_sweep",
+               f"--cpus-per-task={max(1, a.threads)}", f"--chdir={os.getcwd()}",
+               "--output", os.path.join(sdir, os.path.basename(batch)[:-5] + "_%a.log")]
+        cmd += shlex.split(a.slurm_opts)
+        cmd += ["--wrap", f"exec {shlex.quote(sys.executable)} {shlex.quote(os.path.abspath(__file__))} "
+                          f"--slurm-task {shlex.quote(batch)} $SLURM_ARRAY_TASK_ID"]
+        sub = subprocess.run(cmd, capture_output=True, text=True)
+        if sub.returncode != 0:
+            fail(f"sbatch failed: {sub.stderr.strip() or sub.stdout.strip()}", 1)
+        job = sub.stdout.strip().split(";")[0]
+        what = "submitted" if attempt == 1 else "resubmitted (failed before)"
+        print(f"sweep: {len(pending)} runs {what} as Slurm job array {job}; task logs in {sdir}", flush=True)
+        if a.no_wait:
+            print("sweep: not waiting (--no-wait); the same command later collects the results and resubmits "
+                  "what failed", flush=True)
+            return []
+        slurm_wait(job, a.slurm_poll)
+    failed = [run_name(*grid[k]) for k in pending
+              if not is_done(os.path.join(a.out, "runs", run_name(*grid[k])))]
+    for n in failed:
+        print(f"sweep: {n} failed after {a.slurm_retries + 1} attempts (log: {a.out}/runs/{n}/run.log)", flush=True)
+    return failed
+
+
+def slurm_task(a, grid, land):
+    """One array task: the run of grid point points[SLURM_ARRAY_TASK_ID]."""
+    batch = read_json(a.slurm_task[0])
+    if not batch:
+        fail(f"--slurm-task: cannot read {a.slurm_task[0]}")
+    k = batch["points"][int(a.slurm_task[1])]
+    p = grid[k]
+    out_runs = os.path.join(a.out, "runs")
+    os.makedirs(out_runs, exist_ok=True)
+    rc, status, wall, summary = run_one(a, land, p, bed_file(a.bed_dir, p[0], p[1]), out_runs, k + 1, len(grid),
+                                        "(Slurm)")
+    report_run(k + 1, len(grid), p, rc, status, wall, summary, "(Slurm)", out_runs, [])
+    return 0 if status == "ok" else 1
 
 
 def report_run(i, total, p, rc, status, wall, summary, eta, out_runs, failed):
@@ -656,11 +726,27 @@ def main(argv=None):
     ap.add_argument("--regolith-only", action="store_true",
                     help="set only materials.regolith.preset (container and lander keep the file's presets)")
     ap.add_argument("--no-run-plots", action="store_true", help="no per-run plots (plot_landing.py)")
+    ap.add_argument("--slurm", action="store_true",
+                    help="run the grid as Slurm job arrays (one run per task; shared output folder); "
+                         "failed tasks are resubmitted, finished runs never")
+    ap.add_argument("--slurm-opts", default="", help="extra sbatch options, e.g. \"--partition=long --time=4:00:00\"")
+    ap.add_argument("--slurm-retries", type=int, default=2, help="resubmissions of failed tasks (default 2)")
+    ap.add_argument("--slurm-poll", type=float, default=10, help="seconds between queue checks (default 10)")
+    ap.add_argument("--no-wait", action="store_true", help="with --slurm: submit and return")
+    ap.add_argument("--slurm-task", nargs=2, metavar=("BATCH", "INDEX"), help=argparse.SUPPRESS)
     ap.add_argument("--record", default="",
                     help="folder of one small JSON per finished run (to commit); runs recorded there count as done")
     ap.add_argument("--report-only", action="store_true", help="only write aggregate.csv, plots, report.md")
     ap.add_argument("--dry-run", action="store_true", help="list the runs and their state, run nothing")
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if len(argv) == 3 and argv[0] == "--slurm-task":
+        # A Slurm array task: the driver's own arguments, from its batch file.
+        batch = read_json(argv[1])
+        if not batch or "argv" not in batch:
+            fail(f"--slurm-task: cannot read {argv[1]}")
+        argv = batch["argv"] + argv
     a = ap.parse_args(argv)
+    a.argv = [x for x in argv]
     a.out = os.path.abspath(a.out)
     a.config = os.path.abspath(a.config)
     a.bed_dir = os.path.abspath(a.bed_dir)
@@ -718,6 +804,10 @@ def main(argv=None):
         print("\n".join(msg))
     if a.dry_run:
         return 0
+    if a.slurm_task:
+        return slurm_task(a, grid, land)
+    if a.slurm and not shutil.which("sbatch"):
+        fail("--slurm: sbatch not found (Slurm's client commands must be on PATH)")
 
     signal.signal(signal.SIGTERM, on_signal)
     t0 = time.time()

@@ -2,7 +2,7 @@
 """Stand-in for regolith_land in the sweep self-test: writes a plausible
 summary.json, series.csv and surface.csv from the --set options, without a bed.
 FAKE_LAND_FAIL=<substring of --out>: exit 3 (blow-up) for that run;
-FAKE_LAND_SLEEP=<s>: sleep before writing."""
+FAKE_LAND_SLEEP=<s>: sleep before writing; FAKE_LAND_DIE_ONCE: see below."""
 import json
 import math
 import os
@@ -26,6 +26,17 @@ while i < len(args):
         i += 1
 started = time.time()
 time.sleep(float(os.environ.get("FAKE_LAND_SLEEP", "0")))
+# FAKE_LAND_DIE_ONCE=<substring of --out>:<marker file>: the first such run
+# is killed (SIGKILL) half-way, after writing part of its output.
+die = os.environ.get("FAKE_LAND_DIE_ONCE", "")
+if die:
+    what, marker = die.split(":", 1)
+    if what in out and not os.path.exists(marker):
+        open(marker, "w").close()
+        os.makedirs(out, exist_ok=True)
+        with open(os.path.join(out, "series.csv"), "w") as f:
+            f.write("t,x\n0,0\n")
+        os.kill(os.getpid(), 9)
 os.makedirs(out, exist_ok=True)
 with open(os.path.join(out, "stamps.json"), "w") as f:  # when this run was under way
     json.dump({"start": started, "end": time.time()}, f)

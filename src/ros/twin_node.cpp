@@ -821,7 +821,6 @@ bool TwinNode::on_save(regolith_twin::Checkpoint::Request& req, regolith_twin::C
 
 bool TwinNode::on_load(regolith_twin::Checkpoint::Request& req, regolith_twin::Checkpoint::Response& res) {
   try {
-    if (!std::ifstream(req.path).good()) throw rt::InputError(req.path + ": cannot read the file");
     const std::string data = rt::read_checkpoint_file(req.path);
     std::lock_guard<std::mutex> lk(mu_);
     twin_->load_image(req.path, data);
@@ -844,13 +843,9 @@ bool TwinNode::on_set_body_state(regolith_twin::SetBodyState::Request& req, rego
   std::lock_guard<std::mutex> lk(mu_);
   const int b = twin_->body_index(req.body);
   const auto& o = req.pose.orientation;
-  const double qn = std::sqrt(o.w * o.w + o.x * o.x + o.y * o.y + o.z * o.z);
   if (b < 0) {
     res.success = false;
     res.message = "no body named '" + req.body + "'";
-  } else if (!(qn > 1e-9) || !std::isfinite(qn)) {
-    res.success = false;
-    res.message = "pose.orientation is not a valid quaternion";
   } else if (twin_->model().bodies[b].fixed) {
     res.success = false;
     res.message = "body '" + req.body + "' is fixed";
@@ -862,7 +857,7 @@ bool TwinNode::on_set_body_state(regolith_twin::SetBodyState::Request& req, rego
       publish_body_states();
       res.success = true;
       res.message = "ok";
-    } catch (const rt::InputError& e) {  // a non-finite pose or twist: the state is left as it was
+    } catch (const rt::InputError& e) {  // a non-finite pose or twist, a zero quaternion: the state is left as it was
       res.success = false;
       res.message = e.what();
     }

@@ -37,6 +37,23 @@ need_packages() {
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 }
 
+# Slurm for the sweep's cluster test. Its munge dependency (unused: the test
+# runs with AuthType=auth/none) makes its key as the munge user on install,
+# which fails where that user cannot reach /bin/sh (a root directory that is
+# not world-readable, as in some container roots): the key is made here
+# first, as munge's own installer would make it.
+need_slurm() {
+  dpkg-query -W -f='${Status}' slurm-wlm 2>/dev/null | grep -q "install ok installed" && return 0
+  local sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo=sudo
+  if [ ! -e /etc/munge/munge.key ]; then
+    $sudo mkdir -p /etc/munge
+    $sudo sh -c 'umask 077; head -c 1024 /dev/urandom > /etc/munge/munge.key'
+    $sudo chmod 0400 /etc/munge/munge.key
+  fi
+  need_packages slurm-wlm
+}
+
 # Configure and build everything (library, tools, tests) out of source.
 build_all() {
   need_packages "${BUILD_PACKAGES[@]}"

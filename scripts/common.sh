@@ -60,7 +60,9 @@ build_all() {
   local jobs
   mkdir -p "$BUILD"
   jobs=$(nproc 2>/dev/null || echo 2)
-  cmake -S "$ROOT" -B "$BUILD" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release >"$BUILD/configure.log" 2>&1 ||
+  # shellcheck disable=SC2086
+  cmake -S "$ROOT" -B "$BUILD" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release \
+    ${CMAKE_EXTRA:-} >"$BUILD/configure.log" 2>&1 ||
     { cat "$BUILD/configure.log" >&2; return 1; }
   echo "regolith_twin: building in $BUILD ..." >&2
   if ! make -C "$BUILD" -j"$jobs" --no-print-directory all tests >"$BUILD/make.log" 2>&1; then

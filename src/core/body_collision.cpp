@@ -85,6 +85,7 @@ struct ShapeEntry {
   double breaking = 0;                                // Bullet's contact-breaking threshold of the shape, m
   double reach = 0;                                   // bounding radius about the body's centre of mass, m
   bool smooth = false;                                // strictly convex (sphere, ellipsoid): one contact point
+  double half_thickness = 0;  // depth scale of the body–body overlap guard, m (a fixed mesh, a surface: infinite)
 };
 
 // A point reported by Bullet, converted to the conventions of the law.
@@ -213,6 +214,20 @@ ShapeEntry make_entry(const BodyModel& b, const Shape& sh) {
     }
   }
   e.smooth = sh.type == ShapeType::Sphere || sh.type == ShapeType::Ellipsoid;
+  // Half thickness (docs/model.md §13): the smallest half extent of the
+  // shape; a moving mesh, of its hull's box; a fixed mesh is a surface.
+  if (sh.type != ShapeType::Mesh) {
+    e.half_thickness = sh.type == ShapeType::Cylinder ? std::min(sh.size.x(), sh.size.z()) : sh.size.minCoeff();
+  } else if (b.fixed) {
+    e.half_thickness = std::numeric_limits<double>::infinity();
+  } else {
+    Vec3 lo = b.meshes[sh.mesh].vertices[0], hi = lo;
+    for (const Vec3& v : b.meshes[sh.mesh].vertices) {
+      lo = lo.cwiseMin(v);
+      hi = hi.cwiseMax(v);
+    }
+    e.half_thickness = 0.5 * (hi - lo).minCoeff();
+  }
   e.object = std::make_unique<btCollisionObject>();
   e.object->setCollisionShape(e.shape.get());
   e.breaking = e.shape->getContactBreakingThreshold(gContactBreakingThreshold);
@@ -502,6 +517,8 @@ BodyPairLaw body_pair_law(const Model& m, int a, int b) {
 
 void body_body_forces(const Model& m, State& s) {
   s.stats.body_body_contacts = 0;
+  s.stats.max_body_overlap_ratio = 0;
+  s.stats.body_overlap_a = s.stats.body_overlap_b = -1;
   const int nb = static_cast<int>(m.bodies.size());
   if (nb < 2) {
     s.body_points.clear();
@@ -545,6 +562,14 @@ void body_body_forces(const Model& m, State& s) {
           const int n_max = (ea.smooth || eb.smooth) ? 1 : kFacePoints;
           reduce_points(g.raw, tol, n_max, g.raw_tmp, g.order, g.hull, g.taken);
           const int n = static_cast<int>(g.raw.size());
+          // Overlap guard (docs/model.md §13): the deepest point against the thinner shape.
+          const double thin = std::min(ea.half_thickness, eb.half_thickness);
+          for (const RawPoint& p : g.raw)
+            if (thin > 0 && p.depth / thin > s.stats.max_body_overlap_ratio) {
+              s.stats.max_body_overlap_ratio = p.depth / thin;
+              s.stats.body_overlap_a = a;
+              s.stats.body_overlap_b = b;
+            }
           // Deterministic order: by the point's position on body a.
           std::sort(g.raw.begin(), g.raw.end(),
                     [](const RawPoint& p, const RawPoint& q) { return lex_less(p.local_a, q.local_a); });

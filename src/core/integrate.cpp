@@ -31,12 +31,13 @@ void kick_drift(const Model& m, State& s, double h, double dt) {
   const bool free = !s.reach.empty();
   const double* __restrict reach = s.reach.data();
   double max_f2 = s.stats.max_free_disp2, margin = s.stats.free_margin;
+  double max_v2 = 0;  // fastest grain without a reach: the grain-step guard (model.md §13)
   // With sleeping, only the awake grains (ascending ids); sleeping grains
   // keep zero velocities and do not move (model.md §16).
   const bool sleeping = sleep_active(m, s);
   const int* __restrict awake = s.sleep.awake.data();
   const int count = sleeping ? int(s.sleep.awake.size()) : n;
-#pragma omp parallel for schedule(static) reduction(&& : finite) reduction(max : max_d2, max_f2) \
+#pragma omp parallel for schedule(static) reduction(&& : finite) reduction(max : max_d2, max_f2, max_v2) \
     reduction(min : margin) if (n >= m.parallel_min_grains)
   for (int q = 0; q < count; ++q) {
     const int i = sleeping ? awake[q] : q;
@@ -63,9 +64,11 @@ void kick_drift(const Model& m, State& s, double h, double dt) {
       margin = std::min(margin, reach[i] - std::sqrt(d2));
     } else {
       max_d2 = std::max(max_d2, d2);
+      max_v2 = std::max(max_v2, v_mid.squaredNorm());
     }
   }
   s.stats.finite = finite;
+  s.stats.max_grain_step = dt * std::sqrt(max_v2);
   s.stats.max_disp2 = max_d2;
   s.stats.max_free_disp2 = max_f2;
   s.stats.free_margin = margin;

@@ -109,6 +109,7 @@ bool Run::settle() {
 // Stage start: trim, stiffness, gravity, walls taken away, groups held.
 void Run::begin_stage() {
   const Stage& st = plan_.stages[k_];
+  energy_watch_.reset();
   int removed = 0;
   if (st.trim) {  // every grain above the trim height goes
     std::vector<uint8_t> drop(m_.n_grains, 0);
@@ -205,6 +206,7 @@ bool Run::advance() {
     if (!opt_.out_dir.empty()) sample();
     next_sample_ += opt_.sample_every;
   }
+  if (s_.step == step0_ && s_.forces_valid) watch_energy();  // the energy guard's first reference
   step(m_, s_);
   if (st.minimize) {  // quick-min: keep only the velocity along the net force
     const int n = m_.n_grains;
@@ -244,6 +246,7 @@ bool Run::advance() {
   for (Observer* o : obs_) end = o->after_step(m_, s_) || end;
   remove_leaving();
   schedule_check(m_.n_grains > n_before);
+  watch_energy();
   if (end) {
     rep_.ended_by_observer = true;
     end_stage("observer");
@@ -263,10 +266,28 @@ bool Run::advance() {
   return true;
 }
 
+void Run::watch_energy() {
+  const Guards& gd = m_.guards;
+  if (!(gd.max_energy_growth > 0) || gd.energy_check_every <= 0) return;
+  // Energy put in this step: a field, an applied wrench, the stiffness schedule, held grains.
+  bool input = !m_.fields.empty() || sched_on_ || !held_ids_.empty();
+  for (size_t b = 0; b < s_.body_applied_force.size() && !input; ++b)
+    input = s_.body_applied_force[b] != Vec3::Zero() || s_.body_applied_torque[b] != Vec3::Zero();
+  energy_input_ = energy_input_ || input;
+  if ((s_.step - step0_) % gd.energy_check_every != 0) return;
+  if (energy_input_) {
+    energy_watch_.reset();
+    energy_input_ = false;
+    return;
+  }
+  energy_watch_.check(m_, s_);
+}
+
 void Run::add_grains() {
   const int n_old = m_.n_grains;
   for (Observer* o : obs_) o->add_grains(m_, s_);
   if (m_.n_grains == n_old) return;
+  energy_watch_.reset();
   if (int(held_.size()) == n_old) held_.resize(m_.n_grains, 0);
   drop_.assign(m_.n_grains, 0);
   for (Observer* o : obs_) o->grains_added(m_, s_, n_old);
@@ -279,6 +300,7 @@ void Run::remove_leaving() {
   if (!any) return;
   const int n_old = m_.n_grains;
   remove_grains(m_, s_, drop_, plan_.groups, &old_to_new_);
+  energy_watch_.reset();
   // Held grains follow their new numbers (a held grain that left is let go).
   std::vector<uint8_t> held(m_.n_grains, 0);
   size_t k = 0;

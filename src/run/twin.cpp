@@ -116,6 +116,7 @@ void Twin::set_body_state(int b, const Vec3& ref_pos, const Quat& ref_q, const V
   set_body_velocity(bm, bs, vel, omega);
   state_.forces_valid = false;  // lists and forces for the new pose at the next step
   state_.rebuild_requested = true;
+  if (run_) run_->state_edited();
 }
 
 void Twin::apply_wrench(int b, const Vec3& force, const Vec3& torque, double until) {

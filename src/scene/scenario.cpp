@@ -526,10 +526,17 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   m.partitions = int(rd.integer(c, "contact", "partitions", 4, 1, 256));
 
   const YAML::Node gd = rd.map(root, "", "guards", false);
-  rd.only(gd, "guards", {"max_overlap_ratio", "allow_under_resolved", "max_body_step_ratio"});
+  rd.only(gd, "guards",
+          {"max_overlap_ratio", "allow_under_resolved", "max_body_step_ratio", "max_grain_step_ratio",
+           "max_body_overlap_ratio", "max_contacts_per_grain", "max_energy_growth", "energy_check_every"});
   m.guards.max_overlap_ratio = rd.number(gd, "guards", "max_overlap_ratio", 0.25, 0, 2, true);
   m.guards.max_body_step_ratio = rd.number(gd, "guards", "max_body_step_ratio", 1.0, 0, 100);
   m.guards.allow_under_resolved = rd.boolean(gd, "guards", "allow_under_resolved", false);
+  m.guards.max_grain_step_ratio = rd.number(gd, "guards", "max_grain_step_ratio", 1.0, 0, 100);
+  m.guards.max_body_overlap_ratio = rd.number(gd, "guards", "max_body_overlap_ratio", 0.5, 0, 100);
+  m.guards.max_contacts_per_grain = int(rd.integer(gd, "guards", "max_contacts_per_grain", 0, -1, 100000));
+  m.guards.max_energy_growth = rd.number(gd, "guards", "max_energy_growth", 0.1, 0, 1e6);
+  m.guards.energy_check_every = int(rd.integer(gd, "guards", "energy_check_every", 1000, 1, 1000000000));
 
   // Sleeping of quiescent regions (docs/model.md §16).
   const YAML::Node sl = rd.map(root, "", "sleep", false);

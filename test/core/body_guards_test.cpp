@@ -1,9 +1,11 @@
 // Guards on rigid bodies (docs/model.md §13): a body whose state becomes
-// non-finite stops the step with its name, and a body that would drift
-// through a thin plate in one step (tunnelling) is stopped before it passes,
-// while the same body slow enough to be resolved bounces off the plate.
+// non-finite stops the step with its name, a body that would drift through a
+// thin plate in one step (tunnelling) is stopped before it passes, and a body
+// pressed into the plate deeper than half the plate's half thickness is
+// stopped, while the same body slow enough to be resolved bounces off the plate.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -23,7 +25,7 @@ struct PlateScene {
   rt::State s;
 };
 
-PlateScene plate_scene(double speed, double dt, double ratio) {
+PlateScene plate_scene(double speed, double dt, double ratio, double body_kn = 0) {
   PlateScene p;
   rt::Material mat = rt::test::simple_material("structure", 2000, 0.5, 0.5, 0.5);
   mat.structure = true;
@@ -31,6 +33,7 @@ PlateScene plate_scene(double speed, double dt, double ratio) {
   p.m.bodies.push_back(rt::test::box_body("plate", Vec3(0.1, 0.1, 5e-4), 2000, true, 0));
   p.m.bodies.push_back(rt::test::box_body("cube", Vec3(0.01, 0.01, 0.01), 2000, false, 0));
   p.m.kn = 1e6;
+  p.m.body_kn = body_kn;
   p.m.dt = dt;
   p.m.gravity = Vec3::Zero();
   p.m.guards.max_body_step_ratio = ratio;
@@ -71,7 +74,8 @@ TEST(BodyGuards, ACubeResolvedInTimeBouncesOffTheThinPlate) {
 TEST(BodyGuards, ACubeFastEnoughToPassThePlateInOneStepIsStopped) {
   // 200 m/s at dt = 1e-5 s: 2 mm per step, four times the plate's half thickness.
   {
-    PlateScene p = plate_scene(200, 1e-5, 0);  // guard off: it passes through the plate
+    PlateScene p = plate_scene(200, 1e-5, 0);  // guards off: it passes through the plate
+    p.m.guards.max_body_overlap_ratio = 0;
     drop(p, 1000);
     EXPECT_LT(p.s.bodies[1].pos.z(), -0.05);
   }
@@ -104,4 +108,31 @@ TEST(BodyGuards, ANonFiniteBodyStateStopsTheStepNamingTheBody) {
       EXPECT_NE(msg.find("NaN or infinite"), std::string::npos) << msg;
     }
   }
+}
+
+// Body–body stiffness 1e3 N/m: the 16 g cube at 1 m/s would sink v sqrt(m/k)
+// = 4 mm into the 1 mm plate. Off, the run goes on with the cube deeper in
+// the plate than the plate's half thickness; on, it stops at half of it.
+TEST(BodyGuards, ABodyPressedDeepIntoAnotherIsStopped) {
+  {
+    PlateScene p = plate_scene(1, 1e-5, 1, 1e3);
+    p.m.guards.max_body_overlap_ratio = 0;
+    double deepest = 0;
+    for (int k = 0; k < 3000; ++k) {
+      rt::step(p.m, p.s);
+      deepest = std::max(deepest, p.s.stats.max_body_overlap_ratio);
+    }
+    EXPECT_GT(deepest, 1.0);
+  }
+  PlateScene p = plate_scene(1, 1e-5, 1, 1e3);
+  try {
+    for (int k = 0; k < 3000; ++k) rt::step(p.m, p.s);
+    ADD_FAILURE() << "a cube sinking through the plate ran on";
+  } catch (const rt::BlowUpError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("bodies 'plate' and 'cube'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("guards.max_body_overlap_ratio"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("raise body_kn"), std::string::npos) << msg;
+  }
+  // At k = 1e6 N/m (0.13 mm, a quarter of the half thickness) it bounces: ACubeResolvedInTimeBouncesOffTheThinPlate.
 }

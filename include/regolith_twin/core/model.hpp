@@ -139,6 +139,18 @@ struct Guards {
   bool allow_under_resolved = false;
   // A free body may move at most this fraction of body_step_limit (docs/model.md §13) in one step (<= 0: off).
   double max_body_step_ratio = 1.0;
+  // A grain without a free-flight reach may move at most this fraction of the list skin in one step (<= 0: off).
+  double max_grain_step_ratio = 1.0;
+  // Body–body: deepest point over the half thickness of the thinner shape of the pair (<= 0: off).
+  double max_body_overlap_ratio = 0.5;
+  // Touching contacts of one grain (grains, walls, bodies) at most this many; 0: the geometric
+  // bound of the scene's radii and max_overlap_ratio (docs/model.md §13); < 0: off.
+  int max_contacts_per_grain = 0;
+  // Passive scenes (no field, wrench, schedule, held grains or gravity ramp): the total energy may rise
+  // above its lowest value by at most this fraction of the scene's energy scale (<= 0: off),
+  // checked every energy_check_every steps (docs/model.md §13).
+  double max_energy_growth = 0.1;
+  int energy_check_every = 1000;
 };
 
 // Bullet collision objects of the bodies' shapes (defined in body_collision.cpp).

@@ -126,6 +126,12 @@ struct StepStats {
   int bad_body = -1;             // a free body whose state became non-finite (-1: none)
   double max_body_step = 0;      // largest displacement of a point of a free body in the last drift, m
   int max_body_step_body = -1;   // the body of that displacement
+  double max_grain_step = 0;     // largest drift of a grain without a reach in the last step, m
+  double max_body_overlap_ratio = 0;  // deepest body–body point over the thinner shape's half thickness
+  int body_overlap_a = -1, body_overlap_b = -1;  // the bodies of that point
+  bool lists_built = false;      // the grain lists were rebuilt in the last step (contacts per grain are counted)
+  int max_contacts = 0;          // most touching contacts of one grain, counted when lists_built
+  int max_contacts_grain = -1;   // that grain
   double max_disp2 = 0;          // squared max displacement since the last list build, m^2
                                  // (with free flight: of the grains without a reach)
   double max_free_disp2 = 0;     // free flight: squared max displacement of the grains with a reach, m^2
@@ -215,6 +221,7 @@ struct State {
   PairList pairs;
   WallList wall_pairs;
   std::vector<Vec3> pos_at_build;  // positions when the lists were last built
+  std::vector<int> contact_count;  // touching contacts per grain at the last count (scratch, step.hpp)
   // Free flight (model.hpp FreeFlightParams, docs/model.md §18): per grain, the
   // gap guaranteed at the last full build to everything it has no list entry
   // with (0: it has an entry, or free flight is off); empty until a build.

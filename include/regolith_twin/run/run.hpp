@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "regolith_twin/core/step.hpp"
 #include "regolith_twin/run/observer.hpp"
 #include "regolith_twin/run/series.hpp"
 #include "regolith_twin/scene/scenario.hpp"
@@ -104,6 +105,9 @@ class Run {
   RunReport run();
   // The observers' finish() (run() calls it; a stepping front end calls it at the end).
   void finish();
+  // The state was edited from outside (a body's pose or velocity set): the
+  // energy-growth guard takes a new reference (docs/model.md §13).
+  void state_edited() { energy_watch_.reset(); }
 
   const RunReport& report() const { return rep_; }
   Model& model() { return m_; }
@@ -124,6 +128,7 @@ class Run {
   void end_stage(const char* reason);
   void sample();
   void progress();
+  void watch_energy();  // energy-growth guard of passive scenes (docs/model.md §13)
   // Stiffness schedule (docs/model.md §17): its base values at the run's
   // start, then a check after every step (grain speeds every check_every
   // steps, or at once when grains were added).
@@ -157,6 +162,8 @@ class Run {
   std::vector<int> held_ids_;
   std::vector<Vec3> held_pos_;
   StageReport sr_;
+  EnergyWatch energy_watch_;
+  bool energy_input_ = false;  // energy was put in since the last check (field, wrench, schedule, held grains)
   std::chrono::steady_clock::time_point t0_, last_progress_;
 };
 

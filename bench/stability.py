@@ -23,15 +23,29 @@ BIN = os.environ.get("BIN", os.path.join(ROOT, "build/devel/lib/regolith_twin"))
 THREADS = os.environ.get("STABILITY_THREADS", "1")
 WORK = os.environ.get("STABILITY_WORK", os.path.join(ROOT, "out/stability"))  # the runs' own outputs
 
+# Steps per contact of the scene's smallest grains when its summary does not give them.
+N_RULE = {"mascot": 30}  # config/mascot_landing.yaml: steps_per_contact 30 for the smallest grains
+
 # How a run ended, from the tool's exit code and the blow-up message (docs/model.md §13).
 GUARDS = [
     ("NaN or infinite", "non-finite"),
-    ("moved", "step (tunnelling)"),
+    ("' moved", "body step"),
+    ("moved", "grain step"),
     ("bodies '", "body-body overlap"),
     ("touches", "contacts per grain"),
     ("total energy", "energy growth"),
     ("overlap of grain", "overlap"),
 ]
+
+
+def label(outcome, msg):
+    """The guard of a recorded blow-up message (records keep the tool's own words)."""
+    if outcome in ("ok", "refused") or not msg:
+        return outcome
+    for key, name in GUARDS:
+        if key in msg:
+            return name
+    return outcome
 
 
 def classify(rc, text):
@@ -197,7 +211,15 @@ def report(out):
              "figure | wall s |", "|---|---|---|---|---|---|---|---|---|---|"]
     for scene, rs in recs.items():
         rs.sort(key=lambda r: (r["kn_factor"], r["dt_factor"], r["case"]))
+        # Steps per contact of the smallest grains: from the run's summary, else
+        # from the reference (the landing's rule gives 30) as N ∝ 1 / (Δt sqrt(k_n)).
+        ref = next((r for r in rs if r["case"] == "ref"), {})
+        n_ref = ref.get("steps_per_contact_min") or N_RULE.get(scene)
         for r in rs:
+            if r.get("steps_per_contact_min") is None and n_ref and r["outcome"] != "refused":
+                r["steps_per_contact_min"] = n_ref / (r["dt_factor"] * r["kn_factor"] ** 0.5)
+        for r in rs:
+            r["outcome"] = label(r["outcome"], r["message"])
             fig = ""
             if "energy_drift_per_1e6_steps" in r and r["outcome"] == "ok":
                 fig = f"energy drift {r['energy_drift']:+.2e} ({r['energy_drift_per_1e6_steps']:+.2e} per 10⁶ steps)"
@@ -223,25 +245,33 @@ def report(out):
     fig, axes = plt.subplots(1, len(recs), figsize=(4.2 * len(recs), 4), squeeze=False)
     style = {"ok": ("o", "tab:green"), "refused": ("s", "tab:gray")}
     for ax, (scene, rs) in zip(axes[0], recs.items()):
-        for r in rs:
+        k = 0
+        for r in sorted(rs, key=lambda r: (r["dt_factor"], r["kn_factor"])):
+            r["outcome"] = label(r["outcome"], r["message"])
             if r.get("drift"):
                 continue
             m, c = style.get(r["outcome"], ("x", "tab:red"))
-            ax.scatter(r["dt_factor"], r["kn_factor"], marker=m, color=c, s=60)
-            if r["outcome"] not in ("ok",):
-                ax.annotate(r["outcome"], (r["dt_factor"], r["kn_factor"]), fontsize=7, xytext=(4, 4),
+            face = "none" if r.get("energy_off") else c
+            ax.scatter(r["dt_factor"], r["kn_factor"], marker=m, edgecolors=c, facecolors=face if m != "x" else None,
+                       color=c if m == "x" else None, s=60)
+            if r["outcome"] != "ok":
+                text = r["outcome"] + (" (energy guard off)" if r.get("energy_off") else "")
+                ax.annotate(text, (r["dt_factor"], r["kn_factor"]), fontsize=7, xytext=(5, 8 if k % 2 == 0 else -12),
                             textcoords="offset points")
+                k += 1
         # Lines of constant steps per contact: N ∝ 1 / (Δt sqrt(k_n)).
-        ref = next((r for r in rs if r["case"] == "ref"), None)
-        n0 = ref.get("steps_per_contact_min") if ref else None
+        n0 = next((r for r in rs if r["case"] == "ref"), {}).get("steps_per_contact_min") or N_RULE.get(scene)
         if n0:
             import numpy as np
             xs = np.logspace(-0.3, 2, 50)
             for n in [30, 10, 4, 2, 1]:
                 ks = (n0 / (n * xs)) ** 2
-                ax.plot(xs, ks, lw=0.6, color="0.7")
-                i = np.argmin(abs(np.log(ks)))
-                ax.text(xs[i], 1.0, f"N={n}", fontsize=6, color="0.5")
+                ax.plot(xs, ks, lw=0.6, color="0.75", zorder=0)
+                x_top = n0 / (n * np.sqrt(2000))
+                if 0.5 < x_top < 100:
+                    ax.text(x_top, 2000, f"N={n}", fontsize=6, color="0.45", ha="left", va="top")
+                else:
+                    ax.text(0.52, (n0 / (n * 0.52)) ** 2, f"N={n}", fontsize=6, color="0.45", va="bottom")
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlim(0.5, 100)
@@ -249,7 +279,8 @@ def report(out):
         ax.set_xlabel("Δt / scene Δt")
         ax.set_ylabel("k_n / scene k_n")
         ax.set_title(scene)
-    fig.suptitle("Stability edge: green ok, red x stopped by a guard, grey refused at input", fontsize=9)
+    fig.suptitle("Stability edge (N: steps per contact of the smallest grains): green ok, red x stopped by a guard "
+                 "(hollow: energy guard off), grey refused at input", fontsize=8)
     fig.tight_layout()
     fig.savefig(os.path.join(out, "stability.png"), dpi=110)
 

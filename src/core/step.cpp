@@ -17,6 +17,7 @@ namespace rt {
 
 void prime(const Model& m, State& s) {
   build_neighbour_lists(m, s);
+  s.contact_count.assign(m.n_grains, 0);  // the guard's counts (sized here: steps allocate nothing)
   // Forces of the current state without advancing any contact history: the
   // springs and touching flags of the lists are put back after the pass, and
   // body–body points keep the springs they carried in (hold_body_springs).

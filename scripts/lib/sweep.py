@@ -368,7 +368,7 @@ def sweep(a, grid, land):
     pool = concurrent.futures.ThreadPoolExecutor(max_workers=jobs)
     running = {}
     try:
-        for k in range(jobs):
+        for k in range(min(jobs, len(todo))):  # none when every run is done (a sweep stopped in its report)
             running[start(k)] = k
         next_k = jobs
         while running:

@@ -144,8 +144,8 @@ RunReport run_scenario(Scenario& sc, State& s, const RunOptions& opt_in, int thr
   const RunReport rep = run.run();
   sc.groups = run.groups();
   if (!opt.out_dir.empty()) {
+    sr.write_files(opt.out_dir, sc.model, s, rep);  // the summary last, as run_scene writes them
     sr.write_summary(opt.out_dir + "/summary.json", sc.model, s, rep, threads);
-    sr.write_files(opt.out_dir, sc.model, s, rep);
   }
   return rep;
 }

@@ -363,12 +363,13 @@ class Loop:
         if land:
             if self.rng.random() < 0.5:
                 shutil.rmtree(f"{w}/cache")
-            cmd, dirs, ref = self.land_cmd(f"{w}/land", f"{w}/cache"), [f"{w}/land", f"{w}/cache/beds"], "land"
+            cmd, dirs, ref = (self.land_cmd(f"{w}/land", f"{w}/cache"),
+                              [f"{w}/land", f"{w}/land/bed_relax", f"{w}/cache/beds"], "land")
             targets = ["final.ckpt", "summary.json", "surface.csv"] + (
                 [] if os.path.isdir(f"{w}/cache") else [".ckpt"])
         else:
             cmd, dirs, ref = self.sim_cmd(f"{w}/sim"), [f"{w}/sim"], "sim"
-            targets = ["final.ckpt", "final.bed", "summary.json"]
+            targets = ["final.ckpt", "final.bed", "summary.json", "final_grains.txt"]
         target = self.rng.choice(targets)
         delay = self.rng.choice([0, 0, 0.0002, 0.001])
         p = self.start(cmd)

@@ -29,6 +29,14 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib
 from csv_columns import read_csv  # noqa: E402
 
 
+def save(fig, path):
+    """path written whole: a temporary name unique to the process, then renamed
+    (docs/architecture.md, outputs), so a stopped run never leaves part of a plot."""
+    tmp = f"{path}.tmp.{os.getpid()}"
+    fig.savefig(tmp, dpi=100, format="png")
+    os.replace(tmp, path)
+
+
 def load_summary(run):
     path = os.path.join(run, "summary.json")
     if not os.path.exists(path):
@@ -100,7 +108,7 @@ def plot_trajectory(run, s, rim, evs, head):
     ax.grid(alpha=0.3)
     fig.suptitle(head, fontsize=9)
     fig.tight_layout()
-    fig.savefig(os.path.join(run, "trajectory.png"), dpi=100)
+    save(fig, os.path.join(run, "trajectory.png"))
     plt.close(fig)
 
 
@@ -127,7 +135,7 @@ def plot_energy(run, s, evs, head):
     ax.grid(alpha=0.3)
     fig.suptitle(head, fontsize=9)
     fig.tight_layout()
-    fig.savefig(os.path.join(run, "energy.png"), dpi=100)
+    save(fig, os.path.join(run, "energy.png"))
     plt.close(fig)
 
 
@@ -153,7 +161,7 @@ def plot_force(run, s, evs, head):
     ax.grid(alpha=0.3)
     fig.suptitle(head, fontsize=9)
     fig.tight_layout()
-    fig.savefig(os.path.join(run, "force.png"), dpi=100)
+    save(fig, os.path.join(run, "force.png"))
     plt.close(fig)
 
 
@@ -212,7 +220,7 @@ def plot_surface(run, surf, s, summary, head, map_cell=0.03):
         ax.legend(fontsize=8, loc="upper right")
     ax.set_title(head, fontsize=8)
     fig.tight_layout()
-    fig.savefig(os.path.join(run, "surface.png"), dpi=100)
+    save(fig, os.path.join(run, "surface.png"))
     plt.close(fig)
 
 

@@ -8,7 +8,9 @@ a temporary folder that is renamed when the run has finished, so a sweep that
 was stopped is re-run with the same command and continues: finished runs
 (summary.json with status ok) are skipped, unfinished or failed ones redone.
 Afterwards (or with --report-only) OUT/aggregate.csv, OUT/*.png and
-OUT/report.md are written from every run in OUT/runs.
+OUT/report.md are written from every run in OUT/runs. Files are written to a
+temporary name and renamed (docs/architecture.md, outputs), and a sweep holds
+OUT/.regolith_twin.lock while it runs, so a second sweep into it is refused.
 
 With --record DIR every finished run is also kept as one small JSON,
 DIR/<run>.json (its summary and how it was run, paths relative to the
@@ -19,6 +21,8 @@ plots) and runs only the rest.
 import argparse
 import concurrent.futures
 import csv
+import fcntl
+import io
 import json
 import math
 import os
@@ -91,6 +95,48 @@ def bed_command(sim, mat, depth, path):
     return " ".join(shlex.quote(a) for a in args)
 
 
+def temp_name(path):
+    """A temporary name beside path, unique to this process (written, then renamed over path)."""
+    return f"{path}.tmp.{os.getpid()}"
+
+
+def write_text(path, text):
+    """path written whole: a stopped sweep leaves the previous file or none, never part of one."""
+    tmp = temp_name(path)
+    try:
+        with open(tmp, "w") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+
+
+def write_json(path, value):
+    write_text(path, json.dumps(value, indent=1) + "\n")
+
+
+def hold_folder(out):
+    """One sweep per output folder: an exclusive lock on OUT/.regolith_twin.lock
+    for the sweep's lifetime (it ends with the process, even when killed), as
+    regolith_land takes its own (docs/architecture.md, outputs)."""
+    os.makedirs(out, exist_ok=True)
+    f = open(os.path.join(out, ".regolith_twin.lock"), "a+")
+    try:
+        fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        f.seek(0)
+        pid = f.read().strip() or "?"
+        f.close()
+        fail(f"{out}: the output folder is in use by another sweep (pid {pid}); give another --out or wait "
+             "until that sweep ends")
+    f.truncate(0)
+    f.write(f"{os.getpid()}\n")
+    f.flush()
+    return f
+
+
 def read_json(path):
     try:
         with open(path) as f:
@@ -135,10 +181,7 @@ def write_record(record_dir, run_dir):
         return
     os.makedirs(record_dir, exist_ok=True)
     path = os.path.join(record_dir, os.path.basename(run_dir) + ".json")
-    with open(path + ".tmp", "w") as f:
-        json.dump(to_portable({"sweep_run": meta, "summary": summary}), f, indent=1)
-        f.write("\n")
-    os.replace(path + ".tmp", path)
+    write_json(path, to_portable({"sweep_run": meta, "summary": summary}))
 
 
 def restore_records(a, grid):
@@ -153,13 +196,17 @@ def restore_records(a, grid):
         rec = from_portable(rec)
         if rec["summary"].get("status") != "ok" or rec["sweep_run"].get("exit_code") != 0:
             continue
-        if os.path.exists(d):
-            shutil.rmtree(d)
-        os.makedirs(d)
+        # Written in a temporary folder renamed when whole, as a run's own.
+        tmp = os.path.join(a.out, "runs", f".{name}.tmp")
+        if os.path.exists(tmp):
+            shutil.rmtree(tmp)
+        os.makedirs(tmp)
         rec["sweep_run"]["restored_from"] = os.path.join(a.record, name + ".json")
         for f, v in (("sweep_run.json", rec["sweep_run"]), ("summary.json", rec["summary"])):
-            with open(os.path.join(d, f), "w") as fh:
-                json.dump(v, fh, indent=1)
+            write_json(os.path.join(tmp, f), v)
+        if os.path.exists(d):
+            shutil.rmtree(d)
+        os.rename(tmp, d)
         restored += 1
     if restored:
         print(f"sweep: {restored} finished run(s) taken from {a.record}", flush=True)
@@ -283,6 +330,7 @@ def run_one(a, land, point, bed, out_runs, index, total, eta_text):
 def sweep(a, grid, land):
     out_runs = os.path.join(a.out, "runs")
     os.makedirs(out_runs, exist_ok=True)
+    a.lock = hold_folder(a.out)
     if a.record:
         restore_records(a, grid)
     total = len(grid)
@@ -298,9 +346,9 @@ def sweep(a, grid, land):
                      + " --set ".join(meta.get("overrides", [])) + f"\nnow:\n  {a.config} --set "
                      + " --set ".join(want) + "\nuse another --out, or remove that run folder to redo it")
     # The grid of this command, for the report.
-    with open(os.path.join(a.out, "sweep.json"), "w") as f:
-        json.dump(dict(a.grid_lists, config=a.config, bed_dir=a.bed_dir, set=a.set, threads=a.threads,
-                       started=time.strftime("%Y-%m-%d %H:%M:%S")), f, indent=1)
+    write_json(os.path.join(a.out, "sweep.json"),
+               dict(a.grid_lists, config=a.config, bed_dir=a.bed_dir, set=a.set, threads=a.threads,
+                    started=time.strftime("%Y-%m-%d %H:%M:%S")))
     done_before = total - len(todo)
     print(f"sweep: {total} runs in {a.out}/runs ({done_before} already done, {len(todo)} to run)", flush=True)
     if a.slurm:
@@ -320,7 +368,7 @@ def sweep(a, grid, land):
     pool = concurrent.futures.ThreadPoolExecutor(max_workers=jobs)
     running = {}
     try:
-        for k in range(jobs):
+        for k in range(min(jobs, len(todo))):  # none when every run is done (a sweep stopped in its report)
             running[start(k)] = k
         next_k = jobs
         while running:
@@ -372,8 +420,7 @@ def slurm_sweep(a, grid, todo):
         if not pending:
             break
         batch = os.path.join(sdir, f"batch_{time.strftime('%Y%m%d_%H%M%S')}_{attempt}.json")
-        with open(batch, "w") as f:
-            json.dump({"argv": a.argv, "points": pending}, f, indent=1)
+        write_json(batch, {"argv": a.argv, "points": pending})
         cmd = ["sbatch", "--parsable", f"--array=0-{len(pending) - 1}", "--job-name=regolith_sweep",
                f"--cpus-per-task={max(1, a.threads)}", f"--chdir={os.getcwd()}",
                "--output", os.path.join(sdir, os.path.basename(batch)[:-5] + "_%a.log")]
@@ -475,12 +522,13 @@ def write_aggregate(out, rows, outcome_keys):
     cols = ["run"] + KEYS + ["status", "ended_by"] + outcome_keys + ["grains", "packing_fraction", "land_wall_seconds",
                                                          "wall_seconds"]
     path = os.path.join(out, "aggregate.csv")
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(cols)
-        for r in rows:
-            w.writerow(["" if r.get(c) is None else fmt_num(r[c]) if c in ("depth", "angle") else r.get(c)
-                        for c in cols])
+    text = io.StringIO(newline="")
+    w = csv.writer(text)
+    w.writerow(cols)
+    for r in rows:
+        w.writerow(["" if r.get(c) is None else fmt_num(r[c]) if c in ("depth", "angle") else r.get(c)
+                    for c in cols])
+    write_text(path, text.getvalue())
     return path
 
 
@@ -558,7 +606,8 @@ def plot_metrics(out, rows, spread):
         fig.suptitle(f"{label}: mean over repeats, bars {what}", fontsize=10)
         fig.tight_layout()
         path = os.path.join(out, f"{key}.png")
-        fig.savefig(path, dpi=100)
+        fig.savefig(temp_name(path), dpi=100, format="png")
+        os.replace(temp_name(path), path)
         plt.close(fig)
         written.append(path)
     return written
@@ -651,8 +700,7 @@ def write_report(out, rows, outcome_keys, plots, spread, grid_meta):
         L += ["", "Failed or unfinished runs (redone by the next sweep with the same command): "
               + ", ".join(r["run"] for r in bad) + "."]
     path = os.path.join(out, "report.md")
-    with open(path, "w") as f:
-        f.write("\n".join(L) + "\n")
+    write_text(path, "\n".join(L) + "\n")
     return path
 
 

@@ -1,7 +1,7 @@
 // Reusable observers: body contacts, ejecta, active zone, surface height map,
 // region count (see their headers in observers/).
 #include <cmath>
-#include <fstream>
+#include <sstream>
 
 #include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/core/step.hpp"
@@ -124,8 +124,7 @@ void write_surface(const std::string& path, const Model& m, const State& s, doub
     double& t = top[size_t(iy) * n + ix];
     t = std::max(t, s.pos[i].z() + m.grain_radius[i] - reference);
   }
-  std::ofstream out(path);
-  if (!out) throw InputError(path + ": cannot write the surface height map");
+  std::ostringstream out;  // written whole at the end (docs/architecture.md, outputs)
   out << "x,y,height\n";
   for (int iy = 0; iy < n; ++iy)
     for (int ix = 0; ix < n; ++ix) {
@@ -133,6 +132,7 @@ void write_surface(const std::string& path, const Model& m, const State& s, doub
       if (t < -1e299) continue;
       out << (ix + 0.5) * cell - half << ',' << (iy + 0.5) * cell - half << ',' << t << '\n';
     }
+  write_file(path, out.str());
 }
 
 // --- region count ---------------------------------------------------------------
@@ -201,14 +201,14 @@ void Escape::row(const Model& m, const State& s, std::vector<double>& out) const
 
 void Escape::finish(Model& m, State& s) {
   if (log_.empty()) return;
-  std::ofstream f(log_);
-  if (!f) throw InputError(log_ + ": cannot write the log of grains that left");
+  std::ostringstream f;  // written whole at the end (docs/architecture.md, outputs)
   static const char* names[] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
   f << "t,face,mass,x,y,z,vx,vy,vz\n";
   f.precision(10);
   for (const Exit& e : exits_)
     f << e.t << ',' << names[e.face] << ',' << e.mass << ',' << e.pos.x() << ',' << e.pos.y() << ',' << e.pos.z()
       << ',' << e.vel.x() << ',' << e.vel.y() << ',' << e.vel.z() << '\n';
+  write_file(log_, f.str());
 }
 
 void Escape::summary(JsonObject& out) const {

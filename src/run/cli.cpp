@@ -3,6 +3,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
@@ -143,6 +144,10 @@ std::vector<std::string> profile_overrides(const std::string& name, const std::s
 int run_cli(int argc, char** argv, const char* tool) {
   Args a;
   if (const int rc = parse(argc, argv, tool, a); rc >= 0) return rc;
+  // A file grown past the size limit (ulimit -f) fails its write with EFBIG
+  // and is reported naming it, like a full disk, instead of killing the
+  // tool mid-write (docs/architecture.md, outputs).
+  std::signal(SIGXFSZ, SIG_IGN);
 #ifdef _OPENMP
   if (a.threads > 0) omp_set_num_threads(a.threads);
   const int threads = omp_get_max_threads();

@@ -2,8 +2,10 @@
 #include "regolith_twin/run/run.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 
 #include "regolith_twin/core/energy.hpp"
@@ -88,6 +90,12 @@ bool Run::settle() {
     schedule_start();
     if (!opt_.out_dir.empty()) {
       make_dirs(opt_.out_dir);
+      // A summary of an earlier run would look finished beside this run's
+      // partial series (docs/architecture.md, outputs): e.g. a landing's
+      // bed_relax/ folder, relaxed again after a run was killed.
+      const std::string summary = opt_.out_dir + "/summary.json";
+      if (std::remove(summary.c_str()) != 0 && errno != ENOENT)
+        throw InputError(summary + ": cannot remove the summary of an earlier run (" + std::strerror(errno) + ")");
       std::vector<std::string> cols = {"t"};
       for (const Observer* o : obs_) o->columns(cols);
       series_.open(opt_.out_dir + "/series.csv", cols);

@@ -59,6 +59,26 @@ void make_dirs(const std::string& dir) {
 
 std::string temp_name(const std::string& path) { return path + ".tmp." + std::to_string(::getpid()); }
 
+void write_file(const std::string& path, const std::string& text) {
+  const std::string tmp = temp_name(path);
+  std::FILE* f = std::fopen(tmp.c_str(), "w");
+  if (!f) throw InputError(path + ": cannot create output file (" + std::strerror(errno) + ")");
+  bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size() && std::fflush(f) == 0;
+  int err = ok ? 0 : errno;
+  if (std::fclose(f) != 0 && ok) {
+    ok = false;
+    err = errno;
+  }
+  if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
+    ok = false;
+    err = errno;
+  }
+  if (!ok) {
+    std::remove(tmp.c_str());
+    throw InputError(path + ": could not write output file (" + std::strerror(err) + ")");
+  }
+}
+
 OutputFolder::OutputFolder(const std::string& dir) {
   make_dirs(dir);
   const std::string lock = dir + "/.regolith_twin.lock";
@@ -101,24 +121,51 @@ CsvSeries::~CsvSeries() { close(); }
 
 void CsvSeries::open(const std::string& path, const std::vector<std::string>& columns) {
   close();
-  f_ = std::fopen(path.c_str(), "w");
-  if (!f_) throw InputError(path + ": cannot create output file");
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw InputError(path + ": cannot create output file (" + std::strerror(errno) + ")");
+  path_ = path;
+  size_ = 0;
   columns_ = columns.size();
-  for (size_t i = 0; i < columns.size(); ++i) std::fprintf(f_, "%s%s", i ? "," : "", columns[i].c_str());
-  std::fprintf(f_, "\n");
-  std::fflush(f_);
+  std::string line;
+  for (size_t i = 0; i < columns.size(); ++i) line += (i ? "," : "") + columns[i];
+  put(line + "\n");
 }
 
 void CsvSeries::row(const std::vector<double>& values) {
-  if (!f_) return;
-  for (size_t i = 0; i < values.size() && i < columns_; ++i) std::fprintf(f_, "%s%.10g", i ? "," : "", values[i]);
-  std::fprintf(f_, "\n");
-  std::fflush(f_);
+  if (fd_ < 0) return;
+  std::string line;
+  char buf[32];
+  for (size_t i = 0; i < values.size() && i < columns_; ++i) {
+    std::snprintf(buf, sizeof buf, "%s%.10g", i ? "," : "", values[i]);
+    line += buf;
+  }
+  put(line + "\n");
+}
+
+// One write per line (no buffer left to flush later), so a killed run
+// leaves complete lines.
+void CsvSeries::put(const std::string& line) {
+  size_t done = 0;
+  while (done < line.size()) {
+    const ssize_t n = ::write(fd_, line.data() + done, line.size() - done);
+    if (n > 0) {
+      done += size_t(n);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    const int err = n < 0 ? errno : EIO;
+    // Keep the complete lines: a part of this one may have reached the file.
+    const bool cut = ::ftruncate(fd_, size_) == 0;
+    close();
+    throw InputError(path_ + ": could not write output file (" + std::strerror(err) + ")" +
+                     (cut ? "; it keeps the rows written before" : ""));
+  }
+  size_ += long(line.size());
 }
 
 void CsvSeries::close() {
-  if (f_) std::fclose(f_);
-  f_ = nullptr;
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
 }
 
 JsonObject& JsonObject::num(const std::string& k, double v) {
@@ -165,16 +212,6 @@ std::string JsonObject::dump(int indent) const {
   return os.str();
 }
 
-void JsonObject::write(const std::string& path) const {
-  const std::string tmp = temp_name(path);
-  std::FILE* f = std::fopen(tmp.c_str(), "w");
-  if (!f) throw InputError(path + ": cannot create output file");
-  const std::string text = dump(0) + "\n";
-  const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw InputError(path + ": could not write output file");
-  }
-}
+void JsonObject::write(const std::string& path) const { write_file(path, dump(0) + "\n"); }
 
 }  // namespace rt

@@ -1,5 +1,6 @@
 // Output files of a run: a CSV time series flushed row by row (so a run that
-// stops early leaves a readable file) and a small JSON object writer.
+// stops early leaves a readable file), a small JSON object writer, and whole
+// files written to a temporary name and renamed (docs/architecture.md, outputs).
 #pragma once
 
 #include <cstdio>
@@ -40,6 +41,11 @@ void check_writable(const std::string& path);
 // renamed over `path`).
 std::string temp_name(const std::string& path);
 
+// Write `text` to temp_name(path), then rename it over `path`: a run that is
+// killed or stopped by a full disk leaves the previous file or none, never
+// part of one. Throws InputError naming `path` and the reason.
+void write_file(const std::string& path, const std::string& text);
+
 class CsvSeries {
  public:
   CsvSeries() = default;
@@ -48,11 +54,17 @@ class CsvSeries {
   ~CsvSeries();
   // Create the file and write the header line. Throws InputError if it cannot.
   void open(const std::string& path, const std::vector<std::string>& columns);
-  void row(const std::vector<double>& values);  // one line, flushed
+  // One line, flushed. A line that cannot be written whole (a full disk) is
+  // cut off again, so the file keeps complete rows only, and InputError
+  // names the file and the reason.
+  void row(const std::vector<double>& values);
   void close();
 
  private:
-  std::FILE* f_ = nullptr;
+  void put(const std::string& line);
+  int fd_ = -1;
+  std::string path_;
+  long size_ = 0;  // bytes of complete lines
   size_t columns_ = 0;
 };
 

@@ -79,13 +79,14 @@ std::string HornSegments::progress(const Model& m, const State& s) const {
 }
 
 void HornSegments::write_csv(const std::string& path) const {
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (!f) throw InputError(path + ": cannot write");
-  std::fprintf(f, "t,mass,x,y,z,vx,vy,vz\n");
-  for (const Exit& e : exits_)
-    std::fprintf(f, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", e.t, e.mass, e.pos.x(), e.pos.y(), e.pos.z(),
-                 e.vel.x(), e.vel.y(), e.vel.z());
-  std::fclose(f);
+  std::string text = "t,mass,x,y,z,vx,vy,vz\n";  // written whole (docs/architecture.md, outputs)
+  char line[192];
+  for (const Exit& e : exits_) {
+    std::snprintf(line, sizeof line, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", e.t, e.mass, e.pos.x(), e.pos.y(),
+                  e.pos.z(), e.vel.x(), e.vel.y(), e.vel.z());
+    text += line;
+  }
+  write_file(path, text);
 }
 
 }  // namespace rt

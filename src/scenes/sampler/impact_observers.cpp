@@ -3,7 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
+#include <sstream>
 #include <limits>
 #include <stdexcept>
 
@@ -25,9 +25,9 @@ const ImpactClock* need_clock(const ImpactClock* c, const char* who) {
 // is at least t, to rounding of the accumulated time (a millionth of a step).
 bool reached(const Model& m, double after, double t) { return after >= t - 1e-6 * m.dt; }
 
-std::ofstream open_csv(const std::string& path, const char* what) {
-  std::ofstream f(path);
-  if (!f) throw InputError(path + ": cannot write " + what);
+// A CSV file's text, written whole with write_file at the end (docs/architecture.md, outputs).
+std::ostringstream csv_text() {
+  std::ostringstream f;
   f.precision(10);
   return f;
 }
@@ -210,12 +210,13 @@ void EjectionAngles::summary(JsonObject& out) const {
 }
 
 void EjectionAngles::write_csv(const std::string& path) const {
-  std::ofstream f = open_csv(path, "the ejecta launches");
+  std::ostringstream f = csv_text();
   const double v_ref = std::sqrt(g_ * R_);
   f << "t,x_launch,r_launch_over_R,speed,speed_over_sqrt_gR,angle\n";
   for (const EjectaLaunch& e : launches_)
     f << e.t << ',' << e.r << ',' << e.r / R_ << ',' << e.speed << ',' << e.speed / v_ref << ',' << e.angle_deg
       << '\n';
+  write_file(path, f.str());
 }
 
 // --- energy partition (docs/scenes.md B.4) ---------------------------------------------------
@@ -305,7 +306,7 @@ void EnergyPartition::summary(JsonObject& out) const {
 }
 
 void EnergyPartition::write_csv(const std::string& path) const {
-  std::ofstream f = open_csv(path, "the energy partition");
+  std::ostringstream f = csv_text();
   f << 't';
   for (const char* n : kPartNames) f << ',' << n;
   f << '\n';
@@ -316,6 +317,7 @@ void EnergyPartition::write_csv(const std::string& path) const {
     for (double y : v) f << ',' << y;
     f << '\n';
   }
+  write_file(path, f.str());
 }
 
 // --- wave attenuation (docs/scenes.md B.4) -----------------------------------------------------
@@ -413,7 +415,7 @@ void WaveAttenuation::summary(JsonObject& out) const {
 }
 
 void WaveAttenuation::write_csv(const std::string& path) const {
-  std::ofstream f = open_csv(path, "the wave profiles");
+  std::ostringstream f = csv_text();
   f << "t,bin,distance_from,distance_to,distance_mid,max_speed,grains,in_fit\n";
   for (const WaveProfile& w : profiles_)
     for (size_t k = 0; k < w.max_speed.size(); ++k) {
@@ -421,6 +423,7 @@ void WaveAttenuation::write_csv(const std::string& path) const {
       f << w.t_actual << ',' << k << ',' << k * opt_.bin << ',' << (k + 1) * opt_.bin << ',' << (k + 0.5) * opt_.bin
         << ',' << w.max_speed[k] << ',' << w.grains[k] << ',' << int(in) << '\n';
     }
+  write_file(path, f.str());
 }
 
 // --- Z-model fits (docs/scenes.md B.2, B.4) -----------------------------------------------------
@@ -502,7 +505,7 @@ void ZModelSampler::summary(JsonObject& out) const {
 }
 
 void ZModelSampler::write_csv(const std::string& path) const {
-  std::ofstream f = open_csv(path, "the Z-model fits");
+  std::ostringstream f = csv_text();
   f << "t,variant,z,h0,misfit_mean_deg,misfit_sd_deg,misfit_rms_deg,cells,grains,speed_min\n";
   for (const ZSample& z : samples_)
     for (const auto& [name, fit] : {std::pair<const char*, const ZFit*>{"fixed_h0", &z.fixed_h0},
@@ -511,6 +514,7 @@ void ZModelSampler::write_csv(const std::string& path) const {
       f << z.t_actual << ',' << name << ',' << fit->z << ',' << fit->h0 << ',' << fit->misfit_mean_deg << ','
         << fit->misfit_sd_deg << ',' << fit->misfit_rms_deg << ',' << fit->cells << ',' << fit->grains << ','
         << z.speed_min << '\n';
+  write_file(path, f.str());
 }
 
 }  // namespace rt

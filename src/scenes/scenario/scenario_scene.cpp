@@ -4,7 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cstdio>
-#include <fstream>
+#include <sstream>
 
 #include "regolith_twin/observers/energy_series.hpp"
 
@@ -12,12 +12,13 @@ namespace rt {
 namespace {
 
 void write_final(const std::string& path, const Model& m, const State& s) {
-  std::ofstream f(path);
+  std::ostringstream f;  // written whole at the end (docs/architecture.md, outputs)
   f << "# id x y z radius vx vy vz  (SI units)\n";
   f.precision(10);
   for (int i = 0; i < m.n_grains; ++i)
     f << i << ' ' << s.pos[i].x() << ' ' << s.pos[i].y() << ' ' << s.pos[i].z() << ' ' << m.grain_radius[i] << ' '
       << s.vel[i].x() << ' ' << s.vel[i].y() << ' ' << s.vel[i].z() << '\n';
+  write_file(path, f.str());
 }
 
 JsonObject energy_json(const Energy& e) {
@@ -143,8 +144,8 @@ RunReport run_scenario(Scenario& sc, State& s, const RunOptions& opt_in, int thr
   const RunReport rep = run.run();
   sc.groups = run.groups();
   if (!opt.out_dir.empty()) {
+    sr.write_files(opt.out_dir, sc.model, s, rep);  // the summary last, as run_scene writes them
     sr.write_summary(opt.out_dir + "/summary.json", sc.model, s, rep, threads);
-    sr.write_files(opt.out_dir, sc.model, s, rep);
   }
   return rep;
 }

@@ -533,7 +533,7 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   m.guards.max_body_step_ratio = rd.number(gd, "guards", "max_body_step_ratio", 1.0, 0, 100);
   m.guards.allow_under_resolved = rd.boolean(gd, "guards", "allow_under_resolved", false);
   m.guards.max_grain_step_ratio = rd.number(gd, "guards", "max_grain_step_ratio", 1.0, 0, 100);
-  m.guards.max_body_overlap_ratio = rd.number(gd, "guards", "max_body_overlap_ratio", 0.5, 0, 100);
+  m.guards.max_body_overlap_ratio = rd.number(gd, "guards", "max_body_overlap_ratio", 1.0, 0, 100);
   m.guards.max_contacts_per_grain = int(rd.integer(gd, "guards", "max_contacts_per_grain", 0, -1, 100000));
   m.guards.max_energy_growth = rd.number(gd, "guards", "max_energy_growth", 0.1, 0, 1e6);
   m.guards.energy_check_every = int(rd.integer(gd, "guards", "energy_check_every", 1000, 1, 1000000000));

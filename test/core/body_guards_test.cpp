@@ -1,7 +1,7 @@
 // Guards on rigid bodies (docs/model.md §13): a body whose state becomes
 // non-finite stops the step with its name, a body that would drift through a
 // thin plate in one step (tunnelling) is stopped before it passes, and a body
-// pressed into the plate deeper than half the plate's half thickness is
+// pressed into the plate deeper than the plate's half thickness is
 // stopped, while the same body slow enough to be resolved bounces off the plate.
 #include <gtest/gtest.h>
 
@@ -112,7 +112,7 @@ TEST(BodyGuards, ANonFiniteBodyStateStopsTheStepNamingTheBody) {
 
 // Body–body stiffness 1e3 N/m: the 16 g cube at 1 m/s would sink v sqrt(m/k)
 // = 4 mm into the 1 mm plate. Off, the run goes on with the cube deeper in
-// the plate than the plate's half thickness; on, it stops at half of it.
+// the plate than the plate's half thickness; on, it stops there.
 TEST(BodyGuards, ABodyPressedDeepIntoAnotherIsStopped) {
   {
     PlateScene p = plate_scene(1, 1e-5, 1, 1e3);

@@ -142,7 +142,7 @@ struct Guards {
   // A grain without a free-flight reach may move at most this fraction of the list skin in one step (<= 0: off).
   double max_grain_step_ratio = 1.0;
   // Body–body: deepest point over the half thickness of the thinner shape of the pair (<= 0: off).
-  double max_body_overlap_ratio = 0.5;
+  double max_body_overlap_ratio = 1.0;
   // Touching contacts of one grain (grains, walls, bodies) at most this many; 0: the geometric
   // bound of the scene's radii and max_overlap_ratio (docs/model.md §13); < 0: off.
   int max_contacts_per_grain = 0;

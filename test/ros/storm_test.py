@@ -27,7 +27,8 @@ from std_srvs.srv import Trigger
 NODE = "/twin_node/"
 # How long the slow checkpoint load waits for its data (a FIFO written only
 # after this many seconds of wall time). Held under the simulation lock, it
-# would stop /clock for as long, far above MAX_CLOCK_GAP.
+# would stop /clock for as long, far above MAX_CLOCK_GAP (tried: a node that
+# reads the file under the lock fails here with a 3.0 s gap).
 SLOW_LOAD_S = 3.0
 # /clock goes out at ~clock_rate of sim time and at least every 0.1 s of wall
 # time (docs/ros.md). 1 s leaves room for a machine shared with other work;
@@ -276,7 +277,8 @@ class Storm(unittest.TestCase):
                    "slowest_call_s": round(c.slowest[0], 2), "slowest_call": c.slowest[1],
                    "clock_messages": len(arrivals), "clock_rate_hz": round(rate, 1),
                    "clock_max_gap_s": round(max_gap, 3), "expected_clock_hz": clock_rate * rtf,
-                   "rss_before_kib": rss0, "rss_after_kib": rss_kib(self.pid), "body_states_received": self.bodies_received,
+                   "rss_before_kib": rss0, "rss_after_kib": rss_kib(self.pid),
+                   "body_states_received": self.bodies_received,
                    "churn_received": self.received}
         with open(os.path.join(self.out, "figures.json"), "w") as f:
             json.dump(figures, f, indent=1)

@@ -15,6 +15,7 @@
 
 #include "regolith_twin/core/hash.hpp"
 #include "regolith_twin/core/neighbours.hpp"
+#include "regolith_twin/scene/data_file.hpp"
 
 namespace rt {
 namespace {
@@ -334,12 +335,9 @@ void write_checkpoint_file(const std::string& path, const std::string& image) {
 }
 
 std::string read_checkpoint_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open checkpoint");
-  // Read to the end (a pipe or special file has no size to ask for).
-  std::string data(std::istreambuf_iterator<char>(in), {});
-  if (in.bad()) throw InputError(path + ": cannot read checkpoint");
-  return data;
+  // Read to the end (a pipe or special file has no size to ask for), at most
+  // the checkpoint limit (docs/architecture.md, "Loaded files").
+  return read_file_limited(path, kMaxCheckpointBytes, "checkpoint");
 }
 
 State state_from_checkpoint(const std::string& path, const std::string& data, const Model& m) {

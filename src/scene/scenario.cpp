@@ -366,8 +366,13 @@ void apply_override(YAML::Node root, const std::string& assignment) {
     throw InputError("--set '" + assignment + "': expected dotted.key=value");
   const std::string key = assignment.substr(0, eq);
   YAML::Node value;
+  const std::string text = assignment.substr(eq + 1);
+  if (text.size() > kMaxYamlBytes)
+    throw InputError("--set '" + key + "=...': value larger than the limit of " + std::to_string(kMaxYamlBytes) +
+                     " bytes");
+  check_yaml_nesting("--set '" + assignment + "'", text);
   try {
-    value = YAML::Load(assignment.substr(eq + 1));
+    value = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError("--set '" + assignment + "': value is not valid YAML: " + e.what());
   }
@@ -672,6 +677,7 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
 }
 
 Scenario parse_scenario_text(const std::string& yaml_text, const std::string& source) {
+  check_yaml_nesting(source, yaml_text);
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -696,11 +702,12 @@ YAML::Node merged(const YAML::Node& base, const YAML::Node& over) {
 }
 
 YAML::Node read_document(const std::string& path, int depth) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open scenario file");
+  // Size and nesting are bounded before yaml-cpp sees the text (docs/architecture.md, "Loaded files").
+  const std::string text = read_file_limited(path, kMaxYamlBytes, "scenario file");
+  check_yaml_nesting(path, text);
   YAML::Node root;
   try {
-    root = YAML::Load(in);
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError(path + ": not valid YAML: " + e.what());
   }

@@ -92,6 +92,7 @@ class Reader {
   }
   void raw(void* p, size_t n) {
     if (n > data_.size() - pos_) fail("truncated file");
+    if (n == 0) return;  // an empty section: p may be null, which memcpy must not get
     std::memcpy(p, data_.data() + pos_, n);
     pos_ += n;
   }

@@ -385,7 +385,11 @@ void apply_override(YAML::Node root, const std::string& assignment) {
     const std::string& part = parts[i];
     const bool index = !part.empty() && part.find_first_not_of("0123456789") == std::string::npos;
     if (index && !node.IsSequence()) throw InputError("--set '" + assignment + "': '" + part + "' indexes a non-list");
-    if (index && std::stoul(part) >= node.size())
+    // A key needs a mapping (or nothing yet): a list entry or a document that
+    // is a single value has no keys (yaml-cpp would throw past InputError).
+    if (!index && !node.IsMap() && !node.IsNull())
+      throw InputError("--set '" + assignment + "': '" + part + "' is a key of something that is not a mapping");
+    if (index && (part.size() > 9 || std::stoul(part) >= node.size()))  // std::stoul throws past 2^64
       throw InputError("--set '" + assignment + "': index " + part + " is past the end of the list");
     if (i + 1 == parts.size()) {
       if (index)
@@ -446,7 +450,9 @@ const GrainGroup* Scenario::group(const std::string& n) const {
   return nullptr;
 }
 
-Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
+namespace {
+
+Scenario interpret_scenario(const YAML::Node& root, const std::string& source) {
   const Reader rd(source);
   if (!root || !root.IsMap()) throw InputError(source + ": expected a YAML mapping at the top level");
   rd.only(root, "",
@@ -676,6 +682,18 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   return sc;
 }
 
+}  // namespace
+
+Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
+  // A key that is not a plain name, a list where a name belongs: yaml-cpp's
+  // conversion errors become InputErrors naming the file (and line).
+  try {
+    return interpret_scenario(root, source);
+  } catch (const YAML::Exception& e) {
+    throw InputError(source + ": " + e.what());
+  }
+}
+
 Scenario parse_scenario_text(const std::string& yaml_text, const std::string& source) {
   check_yaml_nesting(source, yaml_text);
   YAML::Node root;
@@ -725,7 +743,11 @@ YAML::Node read_document(const std::string& path, int depth) {
     throw InputError(path + ": key 'base': " + e.what());
   }
   root.remove("base");
-  return merged(base, root);
+  try {
+    return merged(base, root);
+  } catch (const YAML::Exception& e) {  // a key that is not a plain name
+    throw InputError(path + ": " + e.what());
+  }
 }
 
 }  // namespace
@@ -733,6 +755,8 @@ YAML::Node read_document(const std::string& path, int depth) {
 YAML::Node load_document(const std::string& path, const std::vector<std::string>& overrides) {
   YAML::Node root = read_document(path, 0);
   for (const auto& o : overrides) apply_override(root, o);
+  // Callers look keys up in it (a lookup in a single value throws past InputError).
+  if (!root.IsMap()) throw InputError(path + ": expected a YAML mapping at the top level");
   return root;
 }
 

@@ -158,9 +158,16 @@ void check_xml_nesting(const std::string& source, const std::string& text, int m
 }
 
 std::vector<GrainRecord> read_sphere_data(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open grain data file");
+  std::ifstream file(path);
+  if (!file) throw InputError(path + ": cannot open grain data file");
   check_file_size(path, kMaxGrainDataBytes, "grain data file");
+  // A file is read line by line; anything else (a pipe, a device without
+  // line ends) is read whole, up to the limit, first.
+  std::error_code ec;
+  std::istringstream whole;
+  if (!std::filesystem::is_regular_file(path, ec))
+    whole.str(read_file_limited(path, kMaxGrainDataBytes, "grain data file"));
+  std::istream& in = whole.str().empty() ? static_cast<std::istream&>(file) : whole;
   std::string line;
   long declared = -1;
   int line_no = 0;

@@ -17,6 +17,7 @@
 #include "regolith_twin/run/scene.hpp"
 #include "regolith_twin/run/series.hpp"
 #include "regolith_twin/scene/checkpoint.hpp"
+#include "regolith_twin/scene/data_file.hpp"
 #include "regolith_twin/scene/snapshot.hpp"
 
 namespace rt {
@@ -125,9 +126,14 @@ std::vector<std::string> profile_overrides(const std::string& name, const std::s
   }
   YAML::Node doc;
   try {
-    doc = YAML::LoadFile(path);
+    // Size and nesting bounded as for scenario files (docs/architecture.md, "Loaded files").
+    const std::string text = read_file_limited(path, kMaxYamlBytes, "profile");
+    check_yaml_nesting(path, text);
+    doc = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError("--profile " + name + ": cannot read " + path + ": " + e.msg);
+  } catch (const InputError& e) {
+    throw InputError("--profile " + name + ": " + e.what());
   }
   if (!doc.IsMap()) throw InputError(path + ": a profile is a map of keys to values (e.g. sleep.enabled: true)");
   std::vector<std::string> out;

@@ -122,7 +122,11 @@ const SceneKind& scene_kind_of(const YAML::Node& root, const std::string& file) 
 std::unique_ptr<Scene> load_scene(const std::string& file, const std::vector<std::string>& overrides,
                                   const SceneOptions& opt) {
   const YAML::Node root = load_document(file, overrides);
-  return scene_kind_of(root, file).prepare(root, file, opt);
+  try {
+    return scene_kind_of(root, file).prepare(root, file, opt);
+  } catch (const YAML::Exception& e) {  // a conversion a scene kind's reader did not check
+    throw InputError(file + ": " + e.what());
+  }
 }
 
 RunReport run_scene(const Scene& scene, Model& m, State& s, const SceneRunOptions& opt,

@@ -16,6 +16,7 @@
 
 #include "regolith_twin/core/hash.hpp"
 #include "regolith_twin/core/neighbours.hpp"
+#include "regolith_twin/scene/data_file.hpp"
 
 namespace rt {
 namespace {
@@ -92,6 +93,7 @@ class Reader {
   }
   void raw(void* p, size_t n) {
     if (n > data_.size() - pos_) fail("truncated file");
+    if (n == 0) return;  // an empty section: p may be null, which memcpy must not get
     std::memcpy(p, data_.data() + pos_, n);
     pos_ += n;
   }
@@ -344,12 +346,9 @@ void write_checkpoint_file(const std::string& path, const std::string& image) {
 }
 
 std::string read_checkpoint_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open checkpoint");
-  // Read to the end (a pipe or special file has no size to ask for).
-  std::string data(std::istreambuf_iterator<char>(in), {});
-  if (in.bad()) throw InputError(path + ": cannot read checkpoint");
-  return data;
+  // Read to the end (a pipe or special file has no size to ask for), at most
+  // the checkpoint limit (docs/architecture.md, "Loaded files").
+  return read_file_limited(path, kMaxCheckpointBytes, "checkpoint");
 }
 
 State state_from_checkpoint(const std::string& path, const std::string& data, const Model& m) {

@@ -366,8 +366,13 @@ void apply_override(YAML::Node root, const std::string& assignment) {
     throw InputError("--set '" + assignment + "': expected dotted.key=value");
   const std::string key = assignment.substr(0, eq);
   YAML::Node value;
+  const std::string text = assignment.substr(eq + 1);
+  if (text.size() > kMaxYamlBytes)
+    throw InputError("--set '" + key + "=...': value larger than the limit of " + std::to_string(kMaxYamlBytes) +
+                     " bytes");
+  check_yaml_nesting("--set '" + assignment + "'", text);
   try {
-    value = YAML::Load(assignment.substr(eq + 1));
+    value = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError("--set '" + assignment + "': value is not valid YAML: " + e.what());
   }
@@ -380,7 +385,11 @@ void apply_override(YAML::Node root, const std::string& assignment) {
     const std::string& part = parts[i];
     const bool index = !part.empty() && part.find_first_not_of("0123456789") == std::string::npos;
     if (index && !node.IsSequence()) throw InputError("--set '" + assignment + "': '" + part + "' indexes a non-list");
-    if (index && std::stoul(part) >= node.size())
+    // A key needs a mapping (or nothing yet): a list entry or a document that
+    // is a single value has no keys (yaml-cpp would throw past InputError).
+    if (!index && !node.IsMap() && !node.IsNull())
+      throw InputError("--set '" + assignment + "': '" + part + "' is a key of something that is not a mapping");
+    if (index && (part.size() > 9 || std::stoul(part) >= node.size()))  // std::stoul throws past 2^64
       throw InputError("--set '" + assignment + "': index " + part + " is past the end of the list");
     if (i + 1 == parts.size()) {
       if (index)
@@ -441,7 +450,9 @@ const GrainGroup* Scenario::group(const std::string& n) const {
   return nullptr;
 }
 
-Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
+namespace {
+
+Scenario interpret_scenario(const YAML::Node& root, const std::string& source) {
   const Reader rd(source);
   if (!root || !root.IsMap()) throw InputError(source + ": expected a YAML mapping at the top level");
   rd.only(root, "",
@@ -678,7 +689,20 @@ Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
   return sc;
 }
 
+}  // namespace
+
+Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
+  // A key that is not a plain name, a list where a name belongs: yaml-cpp's
+  // conversion errors become InputErrors naming the file (and line).
+  try {
+    return interpret_scenario(root, source);
+  } catch (const YAML::Exception& e) {
+    throw InputError(source + ": " + e.what());
+  }
+}
+
 Scenario parse_scenario_text(const std::string& yaml_text, const std::string& source) {
+  check_yaml_nesting(source, yaml_text);
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -703,11 +727,12 @@ YAML::Node merged(const YAML::Node& base, const YAML::Node& over) {
 }
 
 YAML::Node read_document(const std::string& path, int depth) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open scenario file");
+  // Size and nesting are bounded before yaml-cpp sees the text (docs/architecture.md, "Loaded files").
+  const std::string text = read_file_limited(path, kMaxYamlBytes, "scenario file");
+  check_yaml_nesting(path, text);
   YAML::Node root;
   try {
-    root = YAML::Load(in);
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError(path + ": not valid YAML: " + e.what());
   }
@@ -725,7 +750,11 @@ YAML::Node read_document(const std::string& path, int depth) {
     throw InputError(path + ": key 'base': " + e.what());
   }
   root.remove("base");
-  return merged(base, root);
+  try {
+    return merged(base, root);
+  } catch (const YAML::Exception& e) {  // a key that is not a plain name
+    throw InputError(path + ": " + e.what());
+  }
 }
 
 }  // namespace
@@ -733,6 +762,8 @@ YAML::Node read_document(const std::string& path, int depth) {
 YAML::Node load_document(const std::string& path, const std::vector<std::string>& overrides) {
   YAML::Node root = read_document(path, 0);
   for (const auto& o : overrides) apply_override(root, o);
+  // Callers look keys up in it (a lookup in a single value throws past InputError).
+  if (!root.IsMap()) throw InputError(path + ": expected a YAML mapping at the top level");
   return root;
 }
 

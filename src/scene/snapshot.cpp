@@ -2,6 +2,7 @@
 #include "regolith_twin/scene/snapshot.hpp"
 
 #include "regolith_twin/core/hash.hpp"
+#include "regolith_twin/scene/data_file.hpp"
 
 #include <unistd.h>
 
@@ -63,11 +64,7 @@ bool is_snapshot(const std::string& path) {
 }
 
 std::vector<SnapshotGrain> read_snapshot(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw InputError(path + ": cannot open bed snapshot");
-  std::string data(static_cast<size_t>(in.tellg()), '\0');
-  in.seekg(0);
-  if (!in.read(data.data(), data.size())) throw InputError(path + ": cannot read bed snapshot");
+  const std::string data = read_file_limited(path, kMaxSnapshotBytes, "bed snapshot");  // docs/architecture.md
   auto fail = [&](const std::string& what) { throw InputError(path + ": not a usable bed snapshot: " + what); };
   if (data.size() < 24 || (std::memcmp(data.data(), kMagic, 8) != 0 && std::memcmp(data.data(), kMagic64, 8) != 0))
     fail("wrong file type (no snapshot header)");

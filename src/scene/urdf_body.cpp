@@ -19,6 +19,8 @@
 #include <mutex>
 #include <sstream>
 
+#include "regolith_twin/scene/data_file.hpp"
+
 namespace rt {
 namespace {
 
@@ -266,9 +268,9 @@ class Loader {
   }
 
   void parse() {
-    std::ifstream in(path_, std::ios::binary);
-    if (!in) fail("cannot open URDF file");
-    const std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // Size and element depth are bounded before urdfdom sees the text (docs/architecture.md, "Loaded files").
+    const std::string xml = read_file_limited(path_, kMaxUrdfBytes, "URDF file");
+    check_xml_nesting(path_, xml);
     std::string log;
     {
       std::lock_guard<std::mutex> lock(parse_mutex());
@@ -507,9 +509,7 @@ class Loader {
 }  // namespace
 
 TriangleMesh load_stl(const std::string& path, const Vec3& scale) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) stl_fail(path, "cannot open STL file");
-  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string data = read_file_limited(path, kMaxMeshBytes, "STL file");  // docs/architecture.md
   std::vector<RawTriangle> raw;
   // Binary when the size matches the facet count exactly (a binary header may
   // itself begin with "solid"); otherwise ASCII.

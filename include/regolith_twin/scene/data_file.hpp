@@ -3,6 +3,7 @@
 // simple text dump of the final state.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -20,5 +21,35 @@ struct GrainRecord {
 // Read the Atoms section of a LAMMPS sphere data file. Throws InputError
 // naming the file and line on malformed content.
 std::vector<GrainRecord> read_sphere_data(const std::string& path);
+
+// Limits on what a reader accepts before a parser (yaml-cpp, urdfdom, the STL,
+// snapshot and checkpoint readers, Bullet through the meshes) sees a file
+// (docs/architecture.md, "Loaded files"). Generous against the shipped files:
+// scenario YAML and URDF files are a few kB, STL meshes 50 kB, bed snapshots
+// 3 MB, checkpoints of the shipped beds ~100 MB.
+constexpr std::size_t kMaxYamlBytes = std::size_t(8) << 20;         // scenarios, profiles, --set values
+constexpr std::size_t kMaxUrdfBytes = std::size_t(8) << 20;         // URDF files
+constexpr std::size_t kMaxMeshBytes = std::size_t(256) << 20;       // STL meshes (5 M binary facets)
+constexpr std::size_t kMaxSnapshotBytes = std::size_t(2) << 30;     // bed snapshots (67 M float64 grains)
+constexpr std::size_t kMaxCheckpointBytes = std::size_t(16) << 30;  // checkpoints (~20 M grains)
+constexpr std::size_t kMaxGrainDataBytes = std::size_t(4) << 30;    // LAMMPS grain data files
+constexpr int kMaxNesting = 64;  // YAML collections or XML elements inside one another
+
+// Throws InputError naming the path, `what` it is and the limit when the
+// file is larger than max_bytes. A file whose size cannot be asked (a pipe) passes.
+void check_file_size(const std::string& path, std::size_t max_bytes, const std::string& what);
+
+// The whole file, refused as check_file_size does (also when a pipe delivers
+// more than max_bytes). Throws InputError "<path>: cannot open <what>" when
+// it cannot be opened.
+std::string read_file_limited(const std::string& path, std::size_t max_bytes, const std::string& what);
+
+// Refuse YAML text whose collections nest deeper than max_depth: a pre-scan
+// of block indentation, sequence dashes and flow brackets (quoted text,
+// comments and block scalars skipped). `source` names the text in the error.
+void check_yaml_nesting(const std::string& source, const std::string& text, int max_depth = kMaxNesting);
+
+// Refuse XML text whose elements nest deeper than max_depth.
+void check_xml_nesting(const std::string& source, const std::string& text, int max_depth = kMaxNesting);
 
 }  // namespace rt

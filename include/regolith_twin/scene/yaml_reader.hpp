@@ -130,6 +130,7 @@ class YamlReader {
   void only(const YAML::Node& map, const std::string& path, const std::vector<std::string>& keys) const {
     if (!map || !map.IsMap()) return;
     for (const auto& kv : map) {
+      if (!kv.first.IsScalar()) fail(join(path, "?"), "a key must be a plain name, not a list or mapping");
       const std::string k = kv.first.as<std::string>();
       bool ok = false;
       for (const auto& a : keys) ok = ok || a == k;

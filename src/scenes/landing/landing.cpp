@@ -67,9 +67,7 @@ int largest_box(const BodyModel& b) {
   return best;
 }
 
-}  // namespace
-
-LandingSpec parse_landing(const YAML::Node& n, const std::string& src) {
+LandingSpec interpret_landing(const YAML::Node& n, const std::string& src) {
   LandingSpec sp;
   const YamlReader rd(src);
   const std::string p = "landing";
@@ -107,6 +105,17 @@ LandingSpec parse_landing(const YAML::Node& n, const std::string& src) {
   sp.active_radius = rd.number(n, p, "active_radius", sp.active_radius, 0, 1e3);
   sp.trapped_hold = rd.number(n, p, "trapped_hold", sp.trapped_hold, 0, 1e5);
   return sp;
+}
+
+}  // namespace
+
+LandingSpec parse_landing(const YAML::Node& n, const std::string& src) {
+  // yaml-cpp's conversion errors become InputErrors naming the file (and line).
+  try {
+    return interpret_landing(n, src);
+  } catch (const YAML::Exception& e) {
+    throw InputError(src + ": " + e.what());
+  }
 }
 
 Vec3 landing_gravity(const LandingSpec& sp) {

@@ -184,17 +184,17 @@ def sweep_sampler(out):
     bed = ref.get("cache")
     fixed = ["--set", "guards.allow_under_resolved=true"] + (["--relaxed-bed", bed] if bed else [])
     kn_ref, dt_ref = 5.47e6, 1.5e-6  # config/sampler_shot.yaml: k_n and Δt at 50 m/s
-    for f in [1.5, 2, 3, 4, 6]:
+    for f in [1.25, 1.5, 2, 3, 4, 6]:
         r = run_case("sampler", f"dt_x{f}", base + fixed + ["--set", f"sampler.dt_ref={dt_ref * f}"], out,
                      {"dt_factor": f, "kn_factor": 1})
         if r["outcome"] != "ok":
             break
-    for f in [4, 16]:
+    for f in [2, 4, 16]:
         r = run_case("sampler", f"kn_x{f}", base + fixed + ["--set", f"sampler.kn_ref={kn_ref * f}"], out,
                      {"dt_factor": 1, "kn_factor": f})
         if r["outcome"] != "ok":
             break
-    for f in [16, 64]:
+    for f in [2, 4, 16, 64]:
         r = run_case("sampler", f"kn_div{f}", base + fixed + ["--set", f"sampler.kn_ref={kn_ref / f}"], out,
                      {"dt_factor": 1, "kn_factor": 1 / f})
         if r["outcome"] != "ok":
@@ -252,8 +252,10 @@ def report(out):
                 continue
             m, c = style.get(r["outcome"], ("x", "tab:red"))
             face = "none" if r.get("energy_off") else c
-            ax.scatter(r["dt_factor"], r["kn_factor"], marker=m, edgecolors=c, facecolors=face if m != "x" else None,
-                       color=c if m == "x" else None, s=60)
+            if m == "x":
+                ax.scatter(r["dt_factor"], r["kn_factor"], marker=m, color=c, s=60)
+            else:
+                ax.scatter(r["dt_factor"], r["kn_factor"], marker=m, edgecolors=c, facecolors=face, s=60)
             if r["outcome"] != "ok":
                 text = r["outcome"] + (" (energy guard off)" if r.get("energy_off") else "")
                 ax.annotate(text, (r["dt_factor"], r["kn_factor"]), fontsize=7, xytext=(5, 8 if k % 2 == 0 else -12),

@@ -60,6 +60,9 @@ build_all() {
   local jobs
   mkdir -p "$BUILD"
   jobs=$(nproc 2>/dev/null || echo 2)
+  # The node's Python tests import the generated messages from the devel space:
+  # catkin keeps the configure-time PYTHONPATH for the tests' environment.
+  export PYTHONPATH=$BUILD/devel/lib/python3/dist-packages${PYTHONPATH:+:$PYTHONPATH}
   # shellcheck disable=SC2086
   cmake -S "$ROOT" -B "$BUILD" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release \
     ${CMAKE_EXTRA:-} >"$BUILD/configure.log" 2>&1 ||

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "regolith_twin/core/gas.hpp"
+#include "regolith_twin/core/model.hpp"
 #include "regolith_twin/core/state.hpp"
 
 namespace rt {
@@ -50,6 +52,79 @@ void LinearDragField::apply(const Model& m, State& s, int begin, int end) const 
     const double im = inv_mass[i];
     if (im == 0) continue;  // glued grain
     force[i] -= (gamma / im) * (vel[i] - u);
+  }
+}
+
+double GasFlowParams::velocity(double h) const {
+  return u0 + shear * h + (u_log != 0 ? u_log * std::log1p(h / h_log) : 0.0);
+}
+
+double GasFlowParams::gradient(double h) const { return shear + (u_log != 0 ? u_log / (h_log + h) : 0.0); }
+
+GasField::GasField(const GasFlowParams& p) : p_(p) {
+  auto need = [](bool ok, const char* what, double v, const char* range) {
+    if (ok) return;
+    std::ostringstream os;
+    os << "gas field: " << what << " = " << v << " out of range (allowed " << range << ")";
+    throw InputError(os.str());
+  };
+  need(std::isfinite(p.density) && p.density > 0, "density", p.density, "finite, > 0 kg/m^3");
+  need(std::isfinite(p.viscosity) && p.viscosity > 0, "viscosity", p.viscosity, "finite, > 0 Pa s");
+  need(std::isfinite(p.sound_speed) && p.sound_speed > 0, "sound_speed", p.sound_speed, "finite, > 0 m/s");
+  need(std::isfinite(p.gamma) && p.gamma > 1, "gamma", p.gamma, "finite, > 1");
+  need(std::isfinite(p.tp_over_tg) && p.tp_over_tg > 0, "tp_over_tg", p.tp_over_tg, "finite, > 0");
+  need(std::isfinite(p.u0), "u0", p.u0, "finite");
+  need(std::isfinite(p.shear), "shear", p.shear, "finite");
+  need(std::isfinite(p.u_log), "u_log", p.u_log, "finite");
+  need(p.u_log == 0 || (std::isfinite(p.h_log) && p.h_log > 0), "h_log", p.h_log, "finite, > 0 m with u_log");
+  need(std::isfinite(p.anchor_z), "anchor_z", p.anchor_z, "finite");
+  need(p.anchor_slot >= -1, "anchor_slot", p.anchor_slot, ">= -1");
+  if (!finite(p.direction) || p.direction.z() != 0 || !(p.direction.norm() > 0))
+    throw InputError("gas field: the flow direction must be a finite horizontal vector (z = 0), not zero");
+  p_.direction = p.direction.normalized();
+}
+
+double GasField::anchor(const State& s) const {
+  return p_.anchor_slot >= 0 && p_.anchor_slot < int(s.field_values.size()) ? s.field_values[p_.anchor_slot]
+                                                                             : p_.anchor_z;
+}
+
+Vec3 GasField::force(double r, double h, const Vec3& v) const {
+  constexpr double kPi = 3.14159265358979323846;
+  const double d = 2 * r;
+  const double u = p_.velocity(h);
+  const Vec3 v0 = u * p_.direction - v;
+  const double speed = v0.norm();
+  const double re = p_.density * speed * d / p_.viscosity, ma = speed / p_.sound_speed;
+  GasConstants g;
+  g.gamma = p_.gamma;
+  g.tp_over_tg = p_.tp_over_tg;
+  g.kn = std::sqrt(kPi * p_.gamma / 2) * p_.viscosity / (p_.density * d * p_.sound_speed);
+  Vec3 f = Vec3::Zero();
+  if (p_.drag) f += loth_drag_re(re, ma, g) * (kPi * d * p_.viscosity / 8) * v0;
+  const double grad = p_.gradient(h);
+  const double along = v0.dot(p_.direction);
+  if (p_.lift && speed > 0 && grad != 0 && along != 0) {
+    const double omega_star = std::abs(grad) * d / speed;
+    const double sign = (along > 0) == (grad > 0) ? 1.0 : -1.0;
+    f.z() += sign * loth_lift(re, omega_star) * (kPi * d * d * p_.density / 8) * speed * speed;
+  }
+  return f;
+}
+
+void GasField::apply(const Model& m, State& s, int begin, int end) const {
+  const double* __restrict inv_mass = m.grain_inv_mass.data();
+  const double* __restrict radius = m.grain_radius.data();
+  // s.vel: the predicted v(n+1) that the dashpots see (v(n) in prime()).
+  const Vec3* __restrict pos = s.pos.data();
+  const Vec3* __restrict vel = s.vel.data();
+  Vec3* __restrict force = s.force.data();
+  const double z0 = anchor(s);
+  for (int i = begin; i < end; ++i) {
+    if (inv_mass[i] == 0) continue;  // glued grain
+    const double h = pos[i].z() - z0;
+    if (!(h > 0)) continue;  // at or below the anchoring plane: no gas
+    force[i] += this->force(radius[i], h, vel[i]);
   }
 }
 

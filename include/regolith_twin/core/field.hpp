@@ -53,6 +53,50 @@ class LinearDragField final : public Field {
   Vec3 u_;
 };
 
+// A gas flowing over the bed (docs/model.md §10): velocity U(h) along a
+// horizontal direction e, h the height above an anchoring plane, acting on
+// grains whose centre is above that plane with Loth's drag (gas.hpp)
+//   F_D = C_D Re (pi d mu_g / 8) v0,   v0 = U(h) e - v_i,
+// and, where the flow is sheared, Loth's lift, vertical:
+//   F_L = C_L (pi d^2 rho_g / 8) |v0|^2 sign((v0 . e) dU/dh) z,
+// with omega* = |dU/dh| d / |v0| (downward for a grain that outruns the gas).
+// No fluid torque. U(h) = u0 + shear h + u_log ln(1 + h / h_log).
+// The plane's height is s.field_values[anchor_slot] when anchor_slot >= 0
+// (a scene moves it as the bed erodes), else anchor_z.
+struct GasFlowParams {
+  double density = 0;       // rho_g, kg/m^3 (> 0)
+  double viscosity = 0;     // mu_g, Pa s (> 0)
+  double sound_speed = 0;   // c, m/s (> 0)
+  double gamma = 1.33;      // ratio of specific heats (> 1)
+  double tp_over_tg = 1;    // grain over gas temperature (> 0)
+  Vec3 direction = Vec3::UnitX();  // e: horizontal, normalised on construction
+  double u0 = 0;            // m/s
+  double shear = 0;         // 1/s
+  double u_log = 0;         // m/s
+  double h_log = 0;         // m (> 0 when u_log != 0)
+  double anchor_z = 0;      // m
+  int anchor_slot = -1;     // index into State::field_values, or -1
+  bool drag = true, lift = true;
+
+  double velocity(double h) const;  // U(h), m/s
+  double gradient(double h) const;  // dU/dh, 1/s
+};
+
+class GasField final : public Field {
+ public:
+  explicit GasField(const GasFlowParams& p);  // InputError naming the value out of range
+  const char* name() const override { return "gas"; }
+  void apply(const Model& m, State& s, int begin, int end) const override;
+  const GasFlowParams& params() const { return p_; }
+  // The anchoring plane's height in state s, m.
+  double anchor(const State& s) const;
+  // Drag and lift on a grain of radius r at height h above the plane moving at v, N.
+  Vec3 force(double r, double h, const Vec3& v) const;
+
+ private:
+  GasFlowParams p_;
+};
+
 // The field stage: every field of m.fields over fixed blocks of grains (the
 // force pass's m.partitions grain blocks), static OpenMP schedule, serial
 // below m.parallel_min_grains grains. Fields act in the order of m.fields.

@@ -215,6 +215,10 @@ struct State {
   // not state: checkpoints do not hold it.
   std::vector<Vec3> body_applied_force, body_applied_torque;  // N, N m (n_bodies or empty)
 
+  // Evolving parameters of the fields (a gas field's anchoring plane, m), set
+  // and moved by the scene that owns them; checkpointed.
+  std::vector<double> field_values;
+
   std::vector<uint8_t> wall_on;  // 1 while wall w takes part (a lifted cylinder is 0) (n_walls)
 
   // Neighbour bookkeeping.

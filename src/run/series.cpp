@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "regolith_twin/core/types.hpp"
+#include "regolith_twin/scene/data_file.hpp"
 
 namespace rt {
 namespace {
@@ -57,26 +58,8 @@ void make_dirs(const std::string& dir) {
   if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) throw InputError(dir + ": cannot create the folder");
 }
 
-std::string temp_name(const std::string& path) { return path + ".tmp." + std::to_string(::getpid()); }
-
 void write_file(const std::string& path, const std::string& text) {
-  const std::string tmp = temp_name(path);
-  std::FILE* f = std::fopen(tmp.c_str(), "w");
-  if (!f) throw InputError(path + ": cannot create output file (" + std::strerror(errno) + ")");
-  bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size() && std::fflush(f) == 0;
-  int err = ok ? 0 : errno;
-  if (std::fclose(f) != 0 && ok) {
-    ok = false;
-    err = errno;
-  }
-  if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
-    ok = false;
-    err = errno;
-  }
-  if (!ok) {
-    std::remove(tmp.c_str());
-    throw InputError(path + ": could not write output file (" + std::strerror(err) + ")");
-  }
+  write_file_replacing(path, text, "output file", /*sync=*/false);
 }
 
 OutputFolder::OutputFolder(const std::string& dir) {

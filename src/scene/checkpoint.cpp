@@ -325,24 +325,7 @@ std::string checkpoint_image(const Model& m, const State& s) {
 }
 
 void write_checkpoint_file(const std::string& path, const std::string& image) {
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());  // unique per process
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw InputError(path + ": cannot write checkpoint (" + std::strerror(errno) + ")");
-  bool ok = std::fwrite(image.data(), 1, image.size(), f) == image.size() && std::fflush(f) == 0 &&
-            ::fsync(fileno(f)) == 0;
-  int err = ok ? 0 : errno;
-  if (std::fclose(f) != 0 && ok) {
-    ok = false;
-    err = errno;
-  }
-  if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
-    ok = false;
-    err = errno;
-  }
-  if (!ok) {
-    std::remove(tmp.c_str());
-    throw InputError(path + ": could not write checkpoint (" + std::strerror(err) + ")");
-  }
+  write_file_replacing(path, image, "checkpoint", /*sync=*/true);
 }
 
 std::string read_checkpoint_file(const std::string& path) {

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <unistd.h>
+
 namespace rt {
 
 void check_file_size(const std::string& path, std::size_t max_bytes, const std::string& what) {
@@ -18,6 +20,29 @@ void check_file_size(const std::string& path, std::size_t max_bytes, const std::
   if (!ec && size > max_bytes)
     throw InputError(path + ": " + what + " of " + std::to_string(size) + " bytes is larger than the limit of " +
                      std::to_string(max_bytes) + " bytes");
+}
+
+std::string temp_name(const std::string& path) { return path + ".tmp." + std::to_string(::getpid()); }
+
+void write_file_replacing(const std::string& path, const std::string& bytes, const std::string& what, bool sync) {
+  const std::string tmp = temp_name(path);
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) throw InputError(path + ": cannot create " + what + " (" + std::strerror(errno) + ")");
+  bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() && std::fflush(f) == 0 &&
+            (!sync || ::fsync(fileno(f)) == 0);
+  int err = ok ? 0 : errno;
+  if (std::fclose(f) != 0 && ok) {
+    ok = false;
+    err = errno;
+  }
+  if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
+    ok = false;
+    err = errno;
+  }
+  if (!ok) {
+    std::remove(tmp.c_str());
+    throw InputError(path + ": could not write " + what + " (" + std::strerror(err) + ")");
+  }
 }
 
 std::string read_file_limited(const std::string& path, std::size_t max_bytes, const std::string& what) {

@@ -38,23 +38,7 @@ void write_snapshot(const std::string& path, const Model& m, const State& s, boo
   }
   const uint64_t sum = fnv1a(buf.data(), buf.size());
   buf.append(reinterpret_cast<const char*>(&sum), sizeof sum);
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());  // unique per process
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw InputError(path + ": cannot write snapshot (" + std::strerror(errno) + ")");
-  bool ok = std::fwrite(buf.data(), 1, buf.size(), f) == buf.size() && std::fflush(f) == 0 && ::fsync(fileno(f)) == 0;
-  int err = ok ? 0 : errno;
-  if (std::fclose(f) != 0 && ok) {
-    ok = false;
-    err = errno;
-  }
-  if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
-    ok = false;
-    err = errno;
-  }
-  if (!ok) {
-    std::remove(tmp.c_str());
-    throw InputError(path + ": could not write snapshot (" + std::strerror(err) + ")");
-  }
+  write_file_replacing(path, buf, "snapshot", /*sync=*/true);
 }
 
 bool is_snapshot(const std::string& path) {

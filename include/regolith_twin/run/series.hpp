@@ -37,13 +37,9 @@ class OutputFolder {
 // long run rather than at its end.
 void check_writable(const std::string& path);
 
-// A temporary name beside `path`, unique to this process (written, then
-// renamed over `path`).
-std::string temp_name(const std::string& path);
-
-// Write `text` to temp_name(path), then rename it over `path`: a run that is
-// killed or stopped by a full disk leaves the previous file or none, never
-// part of one. Throws InputError naming `path` and the reason.
+// Write `text` as write_file_replacing does (regolith_twin/scene/data_file.hpp),
+// without waiting for the disk: a run killed or stopped by a full disk leaves
+// the previous file or none, never part of one.
 void write_file(const std::string& path, const std::string& text);
 
 class CsvSeries {

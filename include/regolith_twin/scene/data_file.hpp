@@ -44,6 +44,17 @@ void check_file_size(const std::string& path, std::size_t max_bytes, const std::
 // it cannot be opened.
 std::string read_file_limited(const std::string& path, std::size_t max_bytes, const std::string& what);
 
+// A temporary name beside `path`, unique to this process (written, then
+// renamed over `path`).
+std::string temp_name(const std::string& path);
+
+// Write `bytes` to temp_name(path) (flushed to the disk first when `sync`),
+// then rename it over `path`: a writer killed or stopped by a full disk
+// leaves the previous file or none, never part of one. Throws InputError
+// "<path>: cannot create <what> (reason)" or "<path>: could not write <what>
+// (reason)", the temporary file removed.
+void write_file_replacing(const std::string& path, const std::string& bytes, const std::string& what, bool sync);
+
 // Refuse YAML text whose collections nest deeper than max_depth: a pre-scan
 // of block indentation, sequence dashes and flow brackets (quoted text,
 // comments and block scalars skipped). `source` names the text in the error.

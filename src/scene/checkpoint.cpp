@@ -22,11 +22,12 @@ namespace rt {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'G', 'T', 'W', 'C', 'K', 'P', 'T'};
+// 8: the fields' evolving values (a gas field's anchoring plane, docs/model.md §10);
 // 7: free flight (docs/model.md §18): the grains' reaches and the body poses
 // of the last full build; 6 (ticks and the stiffness schedule's state, docs/model.md §17), 5 (sleep
 // state, docs/model.md §16), 4 (history slots of grain–mesh contacts), 3
 // (rigid bodies, no grain–mesh contacts) and 2 (grains only) are still read.
-constexpr uint32_t kVersion = 7;
+constexpr uint32_t kVersion = 8;
 
 // Fingerprint of the static grain description a state belongs to.
 uint64_t model_fingerprint(const Model& m) {
@@ -319,6 +320,7 @@ std::string checkpoint_image(const Model& m, const State& s) {
     w.vec(q4);
   }
   w.pod<int64_t>(s.free_grains_max);
+  w.vec(s.field_values);  // the fields' evolving values (model.md §10)
   const uint64_t sum = fnv1a(w.buf.data(), w.buf.size());
   w.pod(sum);
   return std::move(w.buf);
@@ -345,7 +347,7 @@ State state_from_checkpoint(const std::string& path, const std::string& data, co
   char magic[8];
   r.raw(magic, 8);
   const uint32_t version = r.pod<uint32_t>();
-  if (version != kVersion && version != 6 && version != 5 && version != 4 && version != 3 && version != 2)
+  if (version != kVersion && version != 7 && version != 6 && version != 5 && version != 4 && version != 3 && version != 2)
     r.fail("format version " + std::to_string(version) + ", this build reads version " + std::to_string(kVersion));
   const uint64_t n = r.pod<uint64_t>();
   if (n != uint64_t(m.n_grains))
@@ -474,6 +476,12 @@ State state_from_checkpoint(const std::string& path, const std::string& data, co
         r.fail("free-flight state is invalid");
     }
     s.free_grains_max = r.pod<int64_t>();
+  }
+  if (version >= 8) {
+    r.vec(s.field_values);
+    if (s.field_values.size() > 64) r.fail("more than 64 field values");
+    for (double v : s.field_values)
+      if (!std::isfinite(v)) r.fail("a field value is not finite");
   }
   if (r.pos() + 8 != data.size()) r.fail("unexpected trailing data");
   check_state(r, m, s);

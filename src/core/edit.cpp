@@ -37,6 +37,7 @@ void compact_pairs(PairList& pl, const std::vector<int>& map, int kept) {
         const int j = map[pl.partner[k]];
         if (j < 0) continue;
         pl.partner[out] = j;
+        if (!pl.image.empty()) pl.image[out] = pl.image[k];
         copy_history(pl, k, pl, out);
         ++out;
       }
@@ -47,6 +48,7 @@ void compact_pairs(PairList& pl, const std::vector<int>& map, int kept) {
   pl.row_start[0] = 0;
   pl.row_start.resize(kept + 1);
   pl.partner.resize(out);
+  if (!pl.image.empty()) pl.image.resize(out);
   size_history(pl, out);
   // owner and sqrt_mstar follow in partition_work.
 }
@@ -54,6 +56,7 @@ void compact_pairs(PairList& pl, const std::vector<int>& map, int kept) {
 void clear_pairs(PairList& pl) {
   pl.row_start.clear();
   pl.partner.clear();
+  pl.image.clear();
   pl.owner.clear();
   pl.sqrt_mstar.clear();
   size_history(pl, 0);
@@ -251,6 +254,7 @@ int add_grain(Model& m, State& s, double radius, int material, const Vec3& pos, 
 }
 
 void rotate_grains_about_z(const Model& m, State& s, double angle) {
+  if (m.periodic.any()) throw InputError("rotating the grains: not in a periodic box (the box would not turn)");
   const Quat r(Eigen::AngleAxisd(angle, Vec3::UnitZ()));
   const Mat3 R = r.toRotationMatrix();
   for (int i = 0; i < m.n_grains; ++i) {

@@ -21,7 +21,9 @@ void visit_elastic(const Model& m, const State& s, F&& f) {
     for (int k = pl.row_start[i]; k < pl.row_start[i + 1]; ++k) {
       const int j = pl.partner[k];
       const double rs = m.grain_radius[i] + m.grain_radius[j];
-      const double x = rs - (s.pos[j] - s.pos[i]).norm();
+      Vec3 d = s.pos[j] - s.pos[i];
+      if (!pl.image.empty()) d += m.periodic.shift(pl.image[k]);  // the partner's nearest image
+      const double x = rs - d.norm();
       if (x <= 0) continue;
       const double reff = m.grain_radius[i] * m.grain_radius[j] / rs;
       f(ElasticContact{ElasticContact::GrainGrain, i, j,

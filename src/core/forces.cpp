@@ -69,6 +69,7 @@ void pair_rows(const Model& m, State& s, int gb, int ge, Vec3* __restrict F, Vec
   const int* __restrict partner = pl.partner.data();
   const int* __restrict owner = pl.owner.data();
   uint8_t* __restrict touching = pl.touching.data();
+  const bool periodic = m.periodic.any();
   long contacts = 0;
   double max_ratio = sc.max_overlap_ratio;
   int max_grain = sc.max_overlap_grain;
@@ -86,7 +87,8 @@ void pair_rows(const Model& m, State& s, int gb, int ge, Vec3* __restrict F, Vec
         ti.setZero();
       }
       const int j = partner[k];
-      const Vec3 d = pos[j] - pos[i];
+      Vec3 d = pos[j] - pos[i];
+      if (periodic) d += m.periodic.shift(pl.image[k]);  // the partner's nearest image
       const double ri = radius[i], rj = radius[j];
       const double rs = ri + rj;
       const double dist2 = d.squaredNorm();
@@ -158,6 +160,7 @@ struct alignas(64) ContactBlock {
   alignas(64) double tjx[kBlock], tjy[kBlock], tjz[kBlock];
   alignas(64) double x[kBlock];                            // overlap
   alignas(64) double rmin[kBlock];                         // smaller radius
+  alignas(64) double ox[kBlock], oy[kBlock];               // periodic boxes: shift of j's image, m
   int k[kBlock], i[kBlock], j[kBlock];                     // list entry and its grains
 };
 
@@ -239,7 +242,7 @@ __attribute__((always_inline)) inline void slider(double& sx, double& sy, double
 // linear c0..c3 = kn, kt, cn_coef, ct_coef; Hertz–Mindlin c0..c2 = E*, G*, hm_damp;
 // per record, or the same for all (Uniform: every grain has one material).
 // With Resist, rolling and twisting resistance as in pair_contact<M, true>.
-template <ContactModel M, bool Uniform, bool Resist>
+template <ContactModel M, bool Uniform, bool Resist, bool Periodic>
 void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_law, const GatherSource& g) {
   const double u0 = M == ContactModel::Linear ? uniform_law.kn : uniform_law.e_star;
   const double u1 = M == ContactModel::Linear ? uniform_law.kt : uniform_law.g_star;
@@ -253,7 +256,12 @@ void evaluate_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_l
                  c3 = Uniform ? u3 : b.c3[c], mu = Uniform ? umu : b.mu[c];
     // Geometry (pair_rows).
     const int gi = 3 * b.i[c], gj = 3 * b.j[c], gk = 3 * b.k[c];
-    const double dx = g.pos[gj] - g.pos[gi], dy = g.pos[gj + 1] - g.pos[gi + 1], dz = g.pos[gj + 2] - g.pos[gi + 2];
+    double dx = g.pos[gj] - g.pos[gi], dy = g.pos[gj + 1] - g.pos[gi + 1];
+    const double dz = g.pos[gj + 2] - g.pos[gi + 2];
+    if constexpr (Periodic) {  // the partner's nearest image (pair_rows)
+      dx += b.ox[c];
+      dy += b.oy[c];
+    }
     const double ri = g.radius[b.i[c]], rj = g.radius[b.j[c]];
     const double rs = ri + rj;
     const double dist2 = dx * dx + dy * dy + dz * dz;
@@ -385,10 +393,10 @@ struct RowSums {
 };
 
 // Evaluate a block and add its results in list order, as pair_rows does.
-template <ContactModel M, bool Uniform, bool Resist>
+template <ContactModel M, bool Uniform, bool Resist, bool Periodic>
 void flush_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_law, const GatherSource& g, PairList& pl,
                  Vec3* __restrict F, Vec3* __restrict T, RowSums& r) {
-  evaluate_block<M, Uniform, Resist>(b, nb, dt, uniform_law, g);
+  evaluate_block<M, Uniform, Resist, Periodic>(b, nb, dt, uniform_law, g);
   Vec3* __restrict spring = pl.spring_t.data();
   for (int c = 0; c < nb; ++c) {
     spring[b.k[c]] = Vec3(b.sx[c], b.sy[c], b.sz[c]);
@@ -419,7 +427,7 @@ void flush_block(ContactBlock& b, int nb, double dt, const PairLaw& uniform_law,
   }
 }
 
-template <ContactModel M, bool Uniform, bool Resist>
+template <ContactModel M, bool Uniform, bool Resist, bool Periodic>
 void pair_rows_batched(const Model& m, State& s, int gb, int ge, Vec3* __restrict F, Vec3* __restrict T,
                        ThreadScratch& sc) {
   PairList& pl = s.pairs;
@@ -434,6 +442,8 @@ void pair_rows_batched(const Model& m, State& s, int gb, int ge, Vec3* __restric
   const double* __restrict sqrt_mstar = pl.sqrt_mstar.data();
   uint8_t* __restrict touching = pl.touching.data();
   Vec3* __restrict spring_t = pl.spring_t.data();
+  Vec3 image_shift[9];  // periodic boxes: shift of each image code + 4
+  for (int c = 0; c < 9; ++c) image_shift[c] = m.periodic.shift(c - 4);
   const GatherSource g{flat(s.pos),     radius,           flat(s.vel), flat(s.omega),
                        flat(s.vel_mid), flat(s.omega_mid), flat(pl.spring_t), flat(pl.spring_r),
                        pl.spring_w.data(),  sqrt_mstar};
@@ -451,14 +461,21 @@ void pair_rows_batched(const Model& m, State& s, int gb, int ge, Vec3* __restric
   for (int seg = gb; seg < ge; ++seg)
   for (int k0 = s.seg_begin[seg], kend_rows = s.seg_end[seg]; k0 < kend_rows;) {
     if (nb == kBlock) {
-      flush_block<M, Uniform, Resist>(b, nb, dt, uniform_law, g, pl, F, T, r);
+      flush_block<M, Uniform, Resist, Periodic>(b, nb, dt, uniform_law, g, pl, F, T, r);
       nb = 0;
     }
     const int kend = std::min(kend_rows, k0 + (kBlock - nb));
     const int nb0 = nb;
     for (int k = k0; k < kend; ++k) {
       const int i = owner[k], j = partner[k];
-      const Vec3 d = pos[j] - pos[i];
+      Vec3 d = pos[j] - pos[i];
+      if constexpr (Periodic) {
+        const Vec3 o = image_shift[pl.image[k] + 4];
+        d.x() += o.x();
+        d.y() += o.y();
+        b.ox[nb] = o.x();
+        b.oy[nb] = o.y();
+      }
       const double rs = radius[i] + radius[j];
       const double dist2 = d.squaredNorm();
       const bool touch = dist2 < rs * rs;
@@ -500,7 +517,7 @@ void pair_rows_batched(const Model& m, State& s, int gb, int ge, Vec3* __restric
     contacts += nb - nb0;
     k0 = kend;
   }
-  if (nb) flush_block<M, Uniform, Resist>(b, nb, dt, uniform_law, g, pl, F, T, r);
+  if (nb) flush_block<M, Uniform, Resist, Periodic>(b, nb, dt, uniform_law, g, pl, F, T, r);
   if (r.i >= 0) {
     F[r.i] += r.fi;
     T[r.i] += r.ti;
@@ -715,6 +732,7 @@ void force_pass(const Model& m, State& s) {
   }
   const bool bodies = !m.bodies.empty();
   const bool batched = !s.log_contacts && !s.scalar_kernel;
+  const bool periodic = m.periodic.any();
   const bool sleeping = sleep_active(m, s);
   long wall_contacts = 0, body_contacts = 0;
 #pragma omp parallel if (n >= m.parallel_min_grains)
@@ -737,10 +755,14 @@ void force_pass(const Model& m, State& s) {
         std::fill(T + sc.touched_lo, T + sc.touched_hi, Vec3::Zero());
       }
       const int gb = s.thread_seg_begin[p], ge = s.thread_seg_begin[p + 1];
-      if (batched && m.single_grain_material >= 0)
-        pair_rows_batched<M, true, Resist>(m, s, gb, ge, F, T, sc);
+      if (batched && periodic && m.single_grain_material >= 0)
+        pair_rows_batched<M, true, Resist, true>(m, s, gb, ge, F, T, sc);
+      else if (batched && periodic)
+        pair_rows_batched<M, false, Resist, true>(m, s, gb, ge, F, T, sc);
+      else if (batched && m.single_grain_material >= 0)
+        pair_rows_batched<M, true, Resist, false>(m, s, gb, ge, F, T, sc);
       else if (batched)
-        pair_rows_batched<M, false, Resist>(m, s, gb, ge, F, T, sc);
+        pair_rows_batched<M, false, Resist, false>(m, s, gb, ge, F, T, sc);
       else
         pair_rows<M, Resist>(m, s, gb, ge, F, T, sc);
     }  // (implied barrier)

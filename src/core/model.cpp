@@ -111,6 +111,39 @@ int add_grain(Model& m, double radius, int material, bool fixed) {
   return m.n_grains++;
 }
 
+namespace {
+// Periodic boxes (docs/model.md §11): long enough that a grain meets at most
+// one image of another, walls that do not cut a periodic axis, and none of
+// the features that keep absolute positions between list builds.
+void check_periodic(const Model& m) {
+  const Periodic& p = m.periodic;
+  if (!p.any()) return;
+  const double least = 2 * (2 * m.max_radius + m.skin);
+  const char* names[2] = {"x", "y"};
+  const bool on[2] = {p.x, p.y};
+  for (int a = 0; a < 2; ++a) {
+    if (!on[a]) continue;
+    const double L = p.length[a];
+    if (!std::isfinite(p.lo[a]) || !std::isfinite(L) || !(L >= least)) {
+      std::ostringstream os;
+      os << "model: the periodic box along " << names[a] << " is " << L << " m long; it must be at least "
+         << least << " m = 2 (2 r_max + skin), so that a grain meets one image of another at most";
+      throw InputError(os.str());
+    }
+  }
+  for (const Wall& w : m.walls) {
+    if (w.type != WallType::Plane)
+      throw InputError("model: wall '" + w.name + "': only plane walls are allowed in a periodic box");
+    if ((p.x && w.axis.x() != 0) || (p.y && w.axis.y() != 0))
+      throw InputError("model: wall '" + w.name +
+                       "' cuts a periodic direction: its normal must be perpendicular to the periodic axes");
+  }
+  if (!m.bodies.empty()) throw InputError("model: rigid bodies are not supported in a periodic box");
+  if (m.sleep.enabled) throw InputError("model: sleep.enabled is not supported in a periodic box");
+  if (m.free_flight.enabled) throw InputError("model: free_flight.enabled is not supported in a periodic box");
+}
+}  // namespace
+
 void finalize_model(Model& m) {
   const int nm = m.n_materials();
   if (nm == 0) throw InputError("model: no materials defined");
@@ -178,6 +211,7 @@ void finalize_model(Model& m) {
       for (const Shape& sh : b.shapes)
         if (sh.type != ShapeType::Mesh) take(sh.size.minCoeff());
   m.body_step_limit = limit;
+  check_periodic(m);
   build_body_geometry(m);
 }
 

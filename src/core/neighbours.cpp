@@ -40,10 +40,11 @@ inline int order(long a, long b) { return a < b ? -1 : (a > b ? 1 : 0); }
 // the cut-off and is sorted, so the lists are the same.
 struct Grid {
   Vec3 lo;
-  double inv_cell;
-  int nx, ny, nz;     // dense cells per axis (dense grids)
+  Vec3 inv_cell;      // 1 / cell side per axis (a periodic axis: its length over a whole number of cells)
+  int nx, ny, nz;     // cells per axis (dense grids; periodic axes of any grid)
   bool hashed;
   uint32_t mask;      // buckets - 1 (hashed grids; a power of two minus one)
+  bool px, py;        // periodic along x, y: cell coordinates wrap modulo nx, ny
 };
 
 // Integer cell coordinate of x along one axis (hashed grids; far grains clamped, still correct).
@@ -53,6 +54,25 @@ inline uint32_t bucket_of(const Grid& g, long x, long y, long z) {
   const uint64_t h = uint64_t(x) * 0x9E3779B185EBCA87ULL ^ uint64_t(y) * 0xC2B2AE3D27D4EB4FULL ^
                      uint64_t(z) * 0x165667B19E3779F9ULL;
   return uint32_t((h ^ (h >> 29)) & g.mask);
+}
+
+// Cell coordinate along a periodic axis of n cells (the grain is wrapped;
+// rounding may put it on the far edge).
+inline long periodic_coord(double c, int n) { return std::clamp(long(std::floor(c)), 0L, long(n - 1)); }
+
+// Periodic boxes: every grain moved into [lo, lo + length) along the
+// periodic axes (its position at the last build with it, so displacements
+// since the build stay continuous). Done at each list build.
+void wrap_grains(const Model& m, State& s) {
+  const Periodic& p = m.periodic;
+  for (int a = 0; a < 2; ++a) {
+    if (!(a == 0 ? p.x : p.y)) continue;
+    const double lo = p.lo[a], L = p.length[a];
+    for (int i = 0; i < m.n_grains; ++i) {
+      const double k = std::floor((s.pos[i][a] - lo) / L);
+      if (k != 0) s.pos[i][a] -= k * L;
+    }
+  }
 }
 
 Grid bin_grains(const Model& m, State& s) {
@@ -66,9 +86,18 @@ Grid bin_grains(const Model& m, State& s) {
   double cell = 2 * m.max_radius + m.skin;
   if (!(cell > 0)) cell = 1.0;  // no grains: any cell size
   const long max_cells = std::max<long>(4L * n, 64);
-  const Vec3 ext = (hi - lo) / cell;
+  Grid g{lo, Vec3::Constant(1.0 / cell), 0, 0, 0, false, 0, m.periodic.x, m.periodic.y};
+  Vec3 ext = (hi - lo) / cell;
+  // A periodic axis: a whole number of cells of at least the cut-off tile the box.
+  int per[2] = {0, 0};
+  for (int a = 0; a < 2; ++a) {
+    if (!(a == 0 ? g.px : g.py)) continue;
+    per[a] = std::max(1, int(std::floor(m.periodic.length[a] / cell)));
+    g.lo[a] = m.periodic.lo[a];
+    g.inv_cell[a] = per[a] / m.periodic.length[a];
+    ext[a] = per[a] - 1;
+  }
   const double cells = (std::floor(ext.x()) + 1) * (std::floor(ext.y()) + 1) * (std::floor(ext.z()) + 1);
-  Grid g{lo, 1.0 / cell, 0, 0, 0, false, 0};
   int ncell = 0;
   if (cells <= max_cells) {
     g.nx = int(ext.x()) + 1;
@@ -77,6 +106,8 @@ Grid bin_grains(const Model& m, State& s) {
     ncell = g.nx * g.ny * g.nz;
   } else {
     g.hashed = true;
+    g.nx = per[0];
+    g.ny = per[1];
     uint32_t buckets = 64;
     while (buckets < 2u * uint32_t(n)) buckets *= 2;
     g.mask = buckets - 1;
@@ -86,12 +117,14 @@ Grid bin_grains(const Model& m, State& s) {
   s.cell_of.resize(n);
   s.cell_items.resize(n);
   for (int i = 0; i < n; ++i) {
-    const Vec3 c = (s.pos[i] - g.lo) * g.inv_cell;
+    const Vec3 c = (s.pos[i] - g.lo).cwiseProduct(g.inv_cell);
     int id;
     if (g.hashed) {
-      id = int(bucket_of(g, cell_coord(c.x()), cell_coord(c.y()), cell_coord(c.z())));
+      id = int(bucket_of(g, g.px ? periodic_coord(c.x(), g.nx) : cell_coord(c.x()),
+                         g.py ? periodic_coord(c.y(), g.ny) : cell_coord(c.y()), cell_coord(c.z())));
     } else {
-      const int cx = std::min(int(c.x()), g.nx - 1), cy = std::min(int(c.y()), g.ny - 1),
+      const int cx = g.px ? int(periodic_coord(c.x(), g.nx)) : std::min(int(c.x()), g.nx - 1),
+                cy = g.py ? int(periodic_coord(c.y(), g.ny)) : std::min(int(c.y()), g.ny - 1),
                 cz = std::min(int(c.z()), g.nz - 1);
       id = (cz * g.ny + cy) * g.nx + cx;
     }
@@ -135,7 +168,7 @@ void row_partners(const Model& m, const State& s, const Grid& g, int i, std::vec
     }
   };
   if (g.hashed) {
-    const Vec3 c = (xi - g.lo) * g.inv_cell;
+    const Vec3 c = (xi - g.lo).cwiseProduct(g.inv_cell);
     const long cx = cell_coord(c.x()), cy = cell_coord(c.y()), cz = cell_coord(c.z());
     std::array<uint32_t, 27> b;
     const int nb = buckets_of_box(g, cx - 1, cx + 1, cy - 1, cy + 1, cz - 1, cz + 1, b);
@@ -146,6 +179,71 @@ void row_partners(const Model& m, const State& s, const Grid& g, int i, std::vec
     for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, g.nz - 1); ++z)
       for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, g.ny - 1); ++y)
         for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, g.nx - 1); ++x) scan((z * g.ny + y) * g.nx + x);
+  }
+  std::sort(out.begin() + first, out.end());
+}
+
+// The same in a periodic box: the cells around i wrap along the periodic
+// axes, each partner's nearest image is taken (unique: the box is at least
+// twice the cut-off), and the entry is packed as 16 j + (image code + 4).
+void row_partners_periodic(const Model& m, const State& s, const Grid& g, int i, std::vector<int>& out) {
+  const size_t first = out.size();
+  const Vec3 xi = s.pos[i];
+  const double ri = m.grain_radius[i];
+  const double skin = m.skin;
+  const Periodic& p = m.periodic;
+  const double lx = p.length.x(), ly = p.length.y();
+  const Vec3 c = (xi - g.lo).cwiseProduct(g.inv_cell);
+  long ax[3], ay[3];
+  int nxs = 0, nys = 0;
+  const auto around = [](long c0, bool periodic, int n, long* out3) {
+    int k = 0;
+    for (long d = -1; d <= 1; ++d) {
+      long v = c0 + d;
+      if (periodic) v = ((v % n) + n) % n;
+      if (std::find(out3, out3 + k, v) == out3 + k) out3[k++] = v;
+    }
+    return k;
+  };
+  const long cx = g.px ? periodic_coord(c.x(), g.nx) : (g.hashed ? cell_coord(c.x()) : long(s.cell_of[i] % g.nx));
+  const long cy = g.py ? periodic_coord(c.y(), g.ny)
+                       : (g.hashed ? cell_coord(c.y()) : long((s.cell_of[i] / g.nx) % g.ny));
+  const long cz = g.hashed ? cell_coord(c.z()) : long(s.cell_of[i] / (g.nx * g.ny));
+  nxs = around(cx, g.px, g.nx, ax);
+  nys = around(cy, g.py, g.ny, ay);
+  std::array<uint32_t, 27> cells;
+  int nc = 0;
+  for (long z = cz - 1; z <= cz + 1; ++z)
+    for (int b = 0; b < nys; ++b)
+      for (int a = 0; a < nxs; ++a) {
+        if (g.hashed) {
+          cells[nc++] = bucket_of(g, ax[a], ay[b], z);
+        } else {
+          if (z < 0 || z >= g.nz || ax[a] < 0 || ax[a] >= g.nx || ay[b] < 0 || ay[b] >= g.ny) continue;
+          cells[nc++] = uint32_t((z * g.ny + ay[b]) * g.nx + ax[a]);
+        }
+      }
+  std::sort(cells.begin(), cells.begin() + nc);
+  nc = int(std::unique(cells.begin(), cells.begin() + nc) - cells.begin());
+  for (int k = 0; k < nc; ++k) {
+    const int cc = int(cells[k]);
+    for (int q = s.cell_start[cc]; q < s.cell_start[cc + 1]; ++q) {
+      const int j = s.cell_items[q];
+      if (j <= i) continue;
+      if (m.grain_fixed[i] && m.grain_fixed[j]) continue;  // glued pairs never interact
+      Vec3 d = s.pos[j] - xi;
+      int sx = 0, sy = 0;
+      if (p.x) {
+        sx = -int(std::lround(d.x() / lx));
+        d.x() += sx * lx;
+      }
+      if (p.y) {
+        sy = -int(std::lround(d.y() / ly));
+        d.y() += sy * ly;
+      }
+      const double cut = ri + m.grain_radius[j] + skin;
+      if (d.squaredNorm() < cut * cut) out.push_back(16 * j + (sx + 3 * sy + 4));
+    }
   }
   std::sort(out.begin() + first, out.end());
 }
@@ -161,6 +259,7 @@ void build_pairs(const Model& m, State& s, const Grid& g) {
   nl.row_start.resize(n + 1);
   const PairList& ol = s.pairs;
   const bool have_old = s.lists_valid && static_cast<int>(ol.row_start.size()) == n + 1;
+  const bool periodic = m.periodic.any();
 #pragma omp parallel if (n >= m.parallel_min_grains)
   {
 #pragma omp for schedule(static)
@@ -170,7 +269,10 @@ void build_pairs(const Model& m, State& s, const Grid& g) {
       const int ib = int(long(n) * b / P), ie = int(long(n) * (b + 1) / P);
       for (int i = ib; i < ie; ++i) {
         const size_t before = out.size();
-        row_partners(m, s, g, i, out);
+        if (periodic)
+          row_partners_periodic(m, s, g, i, out);
+        else
+          row_partners(m, s, g, i, out);
         nl.row_start[i + 1] = static_cast<int>(out.size() - before);  // row length for now
       }
     }
@@ -179,13 +281,21 @@ void build_pairs(const Model& m, State& s, const Grid& g) {
       nl.row_start[0] = 0;
       for (int i = 0; i < n; ++i) nl.row_start[i + 1] += nl.row_start[i];
       nl.partner.resize(nl.row_start[n]);
+      nl.image.resize(periodic ? nl.row_start[n] : 0);
       size_history(nl, nl.size());
     }  // (implied barrier)
 #pragma omp for schedule(static)
     for (int b = 0; b < P; ++b) {
       const std::vector<int>& in = s.scratch[b].list_partners;
       const int ib = int(long(n) * b / P), ie = int(long(n) * (b + 1) / P);
-      std::copy(in.begin(), in.end(), nl.partner.begin() + nl.row_start[ib]);
+      if (periodic) {
+        for (size_t q = 0; q < in.size(); ++q) {  // unpack 16 j + (image + 4)
+          nl.partner[nl.row_start[ib] + q] = in[q] >> 4;
+          nl.image[nl.row_start[ib] + q] = int8_t((in[q] & 15) - 4);
+        }
+      } else {
+        std::copy(in.begin(), in.end(), nl.partner.begin() + nl.row_start[ib]);
+      }
       const auto by_partner = [&ol, &nl](int o, int k) { return order(ol.partner[o], nl.partner[k]); };
       for (int i = ib; i < ie; ++i) {
         if (have_old)
@@ -269,7 +379,9 @@ void build_body_grains(const Model& m, State& s, const Grid& g) {
     // the rounding of the coordinates.
     const double reach_max = bm.bound_radius + m.max_radius + m.skin;
     const double h = reach_max + 1e-9 * (reach_max + bs.pos.cwiseAbs().maxCoeff() + g.lo.cwiseAbs().maxCoeff());
-    const Vec3 a = (bs.pos - Vec3::Constant(h) - g.lo) * g.inv_cell, c = (bs.pos + Vec3::Constant(h) - g.lo) * g.inv_cell;
+    // (bodies are not allowed in periodic boxes: the cells are cubes here)
+    const Vec3 a = (bs.pos - Vec3::Constant(h) - g.lo) * g.inv_cell.x(),
+               c = (bs.pos + Vec3::Constant(h) - g.lo) * g.inv_cell.x();
     auto test = [&](int i) {
       if (m.grain_inv_mass[i] + inv_body == 0) return;  // glued grain against an immovable body
       const double ri = m.grain_radius[i];
@@ -477,7 +589,7 @@ double grain_reach(const Model& m, const State& s, const Grid& g, int i) {
   const int K = m.free_flight.reach_cells;
   const Vec3 xi = s.pos[i];
   const double ri = m.grain_radius[i];
-  double c = K / g.inv_cell - ri - m.max_radius;
+  double c = K / g.inv_cell.x() - ri - m.max_radius;  // cubic cells (no free flight in periodic boxes)
   auto scan = [&](int cc) {
     for (int q = s.cell_start[cc]; q < s.cell_start[cc + 1]; ++q) {
       const int j = s.cell_items[q];
@@ -485,7 +597,7 @@ double grain_reach(const Model& m, const State& s, const Grid& g, int i) {
     }
   };
   if (g.hashed) {
-    const Vec3 cc = (xi - g.lo) * g.inv_cell;
+    const Vec3 cc = (xi - g.lo) * g.inv_cell.x();
     const long cx = cell_coord(cc.x()), cy = cell_coord(cc.y()), cz = cell_coord(cc.z());
     static thread_local std::vector<uint32_t> buckets;  // capacity kept between builds
     buckets.resize(size_t(2 * K + 1) * (2 * K + 1) * (2 * K + 1));
@@ -571,6 +683,7 @@ bool lists_need_rebuild(const Model& m, const State& s) {
 }
 
 void build_neighbour_lists(const Model& m, State& s) {
+  if (m.periodic.any()) wrap_grains(m, s);
   const Grid g = bin_grains(m, s);
   build_pairs(m, s, g);
   build_walls(m, s);

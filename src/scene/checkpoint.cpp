@@ -321,6 +321,7 @@ std::string checkpoint_image(const Model& m, const State& s) {
   }
   w.pod<int64_t>(s.free_grains_max);
   w.vec(s.field_values);  // the fields' evolving values (model.md §10)
+  w.vec(s.pairs.image);   // periodic boxes: the image of each pair entry's partner (model.md §11)
   const uint64_t sum = fnv1a(w.buf.data(), w.buf.size());
   w.pod(sum);
   return std::move(w.buf);
@@ -482,6 +483,16 @@ State state_from_checkpoint(const std::string& path, const std::string& data, co
     if (s.field_values.size() > 64) r.fail("more than 64 field values");
     for (double v : s.field_values)
       if (!std::isfinite(v)) r.fail("a field value is not finite");
+    r.vec(s.pairs.image);
+  }
+  if (s.pairs.image.size() != (m.periodic.any() ? s.pairs.partner.size() : 0))
+    r.fail(m.periodic.any() ? "the pair list's periodic images do not match its entries (or the file was written "
+                              "without periodic boundaries)"
+                            : "the pair list has periodic images, the scenario has no periodic box");
+  for (int8_t c : s.pairs.image) {
+    const int sx = (c + 4) % 3 - 1, sy = (c - sx) / 3;
+    if (c < -4 || c > 4 || (!m.periodic.x && sx != 0) || (!m.periodic.y && sy != 0))
+      r.fail("a periodic image code is out of range");
   }
   if (r.pos() + 8 != data.size()) r.fail("unexpected trailing data");
   check_state(r, m, s);

@@ -80,6 +80,24 @@ struct Wall {
   int law_material = 0;        // index of the wall's material (its eps, and friction unless set)
 };
 
+// Periodic boundaries in x and/or y (docs/model.md §11): the box
+// [lo, lo + length) repeats along each periodic axis. A pair list entry
+// holds the image of its partner nearest to its owner (image code
+// sx + 3 sy, sx, sy in {-1, 0, 1}: the partner's position plus
+// (sx length.x, sy length.y, 0)); grains are wrapped into the box at every
+// list build.
+struct Periodic {
+  bool x = false, y = false;
+  Vec3 lo = Vec3::Zero();      // box start along x and y, m (z unused)
+  Vec3 length = Vec3::Zero();  // box lengths along x and y, m (z unused)
+  bool any() const { return x || y; }
+  // The shift of image code c (in [-4, 4]), m.
+  Vec3 shift(int c) const {
+    const int sx = (c + 4) % 3 - 1, sy = (c - sx) / 3;
+    return Vec3(sx * length.x(), sy * length.y(), 0);
+  }
+};
+
 // Guard thresholds: a run that crosses them stops with a diagnostic.
 // Sleeping of quiescent regions (docs/model.md §16). Grains are binned in
 // cubic sleep cells; a cell whose grains stay slow and whose contact forces
@@ -186,6 +204,7 @@ struct Model {
   // at a time (a concurrent call throws std::logic_error).
   mutable std::shared_ptr<BodyGeometry> body_geometry;
   Vec3 gravity = Vec3(0, 0, -9.81);    // m/s^2
+  Periodic periodic;                   // none by default
   // Per-grain force fields added after the contacts (field.hpp), in this
   // order. Shared, immutable: copies of the Model share them. Empty: none.
   std::vector<std::shared_ptr<const Field>> fields;

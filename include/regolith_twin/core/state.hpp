@@ -25,6 +25,9 @@ struct PairList {
   std::vector<Vec3> spring_r;   // rolling spring delta_R, rad
   std::vector<double> spring_w; // twisting spring delta_T along n, rad
   std::vector<uint8_t> touching; // 1 while the pair overlaps (its springs are live)
+  // Periodic boxes: the image code of each entry's partner (Periodic::shift);
+  // empty otherwise.
+  std::vector<int8_t> image;
   int size() const { return static_cast<int>(partner.size()); }
 };
 

@@ -37,6 +37,11 @@ std::string bed_key(const Model& m, const State& s, const std::vector<int>& plac
   }
   const double v[] = {m.gravity.x(), m.gravity.y(), m.gravity.z(), m.kn, m.dt, m.skin, double(m.partitions)};
   h = fnv1a(v, sizeof v, h);
+  if (m.periodic.any()) {  // (beds without a periodic box keep their keys)
+    const Periodic& p = m.periodic;
+    const double w[] = {double(p.x), double(p.y), p.lo.x(), p.lo.y(), p.length.x(), p.length.y()};
+    h = fnv1a(w, sizeof w, h);
+  }
   char buf[32];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
   return buf;

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "regolith_twin/core/edit.hpp"
+#include "regolith_twin/core/field.hpp"
 #include "regolith_twin/core/walls.hpp"
 #include "regolith_twin/scene/data_file.hpp"
 #include "regolith_twin/scene/generate.hpp"
@@ -456,8 +457,8 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source) {
   const Reader rd(source);
   if (!root || !root.IsMap()) throw InputError(source + ": expected a YAML mapping at the top level");
   rd.only(root, "",
-          {"name", "seed", "gravity", "contact", "guards", "sleep", "schedule", "free_flight", "materials", "walls", "bodies", "grains",
-           "stages", "output"});
+          {"name", "seed", "gravity", "contact", "guards", "sleep", "schedule", "free_flight", "periodic", "gas",
+           "materials", "walls", "bodies", "grains", "stages", "output"});
   Scenario sc;
   sc.file = source;
   sc.name = rd.text(root, "", "name", "scenario");
@@ -577,6 +578,48 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source) {
   rd.only(ff, "free_flight", {"enabled", "reach_cells"});
   m.free_flight.enabled = rd.boolean(ff, "free_flight", "enabled", false);
   m.free_flight.reach_cells = int(rd.integer(ff, "free_flight", "reach_cells", m.free_flight.reach_cells, 1, 16));
+
+  // Periodic boundaries (docs/model.md §11.1): periodic.x / periodic.y = [lo, hi].
+  const YAML::Node per = rd.map(root, "", "periodic", false);
+  rd.only(per, "periodic", {"x", "y"});
+  for (int a = 0; a < 2; ++a) {
+    const std::string key = a == 0 ? "x" : "y";
+    const YAML::Node n = Reader::get(per, key);
+    if (!n) continue;
+    const std::string path = "periodic." + key;
+    if (!n.IsSequence() || n.size() != 2) rd.fail(path, "expected [lo, hi] (m)");
+    const double lo = rd.number(n[0], path + "[0]", -kInf, kInf);
+    const double hi = rd.number(n[1], path + "[1]", lo, kInf, true);
+    (a == 0 ? m.periodic.x : m.periodic.y) = true;
+    m.periodic.lo[a] = lo;
+    m.periodic.length[a] = hi - lo;
+  }
+
+  // A gas flowing over the grains (docs/model.md §10.1).
+  if (const YAML::Node gas = rd.map(root, "", "gas", false)) {
+    rd.only(gas, "gas", {"density", "viscosity", "sound_speed", "gamma", "temperature_ratio", "direction", "u0",
+                         "shear", "u_log", "h_log", "anchor_z", "drag", "lift"});
+    GasFlowParams g;
+    g.density = rd.number(gas, "gas", "density", 0, 0, kInf, true);
+    g.viscosity = rd.number(gas, "gas", "viscosity", 0, 0, kInf, true);
+    g.sound_speed = rd.number(gas, "gas", "sound_speed", 0, 0, kInf, true);
+    if (!(g.density > 0) || !(g.viscosity > 0) || !(g.sound_speed > 0))
+      rd.fail("gas", "density (kg/m^3), viscosity (Pa s) and sound_speed (m/s) are required");
+    g.gamma = rd.number(gas, "gas", "gamma", g.gamma, 1, 10, true);
+    g.tp_over_tg = rd.number(gas, "gas", "temperature_ratio", g.tp_over_tg, 0, 1e3, true);
+    g.direction = rd.vec3(gas, "gas", "direction", Vec3::UnitX());
+    if (g.direction.z() != 0 || !(g.direction.norm() > 0))
+      rd.fail("gas.direction", "expected a horizontal direction [x, y, 0], not zero");
+    g.u0 = rd.number(gas, "gas", "u0", 0, -1e5, 1e5);
+    g.shear = rd.number(gas, "gas", "shear", 0, -1e9, 1e9);
+    g.u_log = rd.number(gas, "gas", "u_log", 0, -1e5, 1e5);
+    g.h_log = rd.number(gas, "gas", "h_log", 0, 0, kInf);
+    if (g.u_log != 0 && !(g.h_log > 0)) rd.fail("gas.h_log", "required (> 0 m) with u_log");
+    g.anchor_z = rd.number(gas, "gas", "anchor_z", 0, -kInf, kInf);
+    g.drag = rd.boolean(gas, "gas", "drag", true);
+    g.lift = rd.boolean(gas, "gas", "lift", true);
+    m.fields.push_back(std::make_shared<GasField>(g));
+  }
 
   finalize_model(m);
   sc.scene_kn = m.kn;

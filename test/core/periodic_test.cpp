@@ -71,7 +71,7 @@ double relative(const Vec3& a, const Vec3& b) { return (a - b).norm() / std::max
 
 TEST(Periodic, ContactAcrossTheBoundaryKeepsItsSpringsAndForces) {
   Pair open = crossing_pair(false), box = crossing_pair(true);
-  const int steps = 40;  // the contact lasts ~50 steps
+  const int steps = 30;  // the contact lasts 37 steps
   int wraps = 0;
   double worst_force = 0, worst_spring = 0, worst_vel = 0;
   double last_y = box.s.pos[0].y();

@@ -76,6 +76,12 @@ class Soak(unittest.TestCase):
         print("soak: " + json.dumps(figures))
         for topic, n in received.items():
             self.assertGreater(n, 0, "nothing received on " + topic)
+        if os.environ.get("REGOLITH_SANITIZER"):
+            # AddressSanitizer keeps freed blocks in quarantine and ThreadSanitizer
+            # keeps access history: VmRSS grows without a leak. LeakSanitizer
+            # checks for leaks at the node's exit instead.
+            print("soak: memory bound not checked under the %s sanitizer" % os.environ["REGOLITH_SANITIZER"])
+            return
         self.assertLess(growth, GROWTH_BOUND_KIB,
                         "VmRSS grew by %d KiB over %d steps after the warm-up (%d KiB at %d steps, %d at the end)" %
                         (growth, steps - warm_steps, rss_warm, warm_steps, rss_end))

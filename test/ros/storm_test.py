@@ -313,6 +313,12 @@ class Storm(unittest.TestCase):
         # ... a wrong answer (a bad request accepted, a good one refused, the
         # slow load refused) ...
         self.assertFalse(c.wrong, "calls answered wrongly:\n" + "\n".join(c.wrong[:20]))
+        # The same node built with a sanitizer runs several times slower, below
+        # real time: what follows bounds times and rates, which it cannot keep.
+        if os.environ.get("REGOLITH_SANITIZER"):
+            print("storm: time and rate bounds not checked under the %s sanitizer" % os.environ["REGOLITH_SANITIZER"])
+            self.assertGreater(sum(self.received.values()), 0, "no message on any churned topic")
+            return
         # ... a service serialised behind a slow one for seconds ...
         self.assertLess(c.slowest[0], MAX_CALL_S, "slowest answer: %s" % (c.slowest,))
         # ... a stall of the stepping loop behind a service holding the

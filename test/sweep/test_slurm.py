@@ -14,9 +14,10 @@ import shutil
 import socket
 import subprocess
 import sys
-import tempfile
 import time
 import unittest
+
+from test_sweep import make_sweep_folder, remove_sweep_folder  # (this folder is on the path)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
@@ -102,21 +103,13 @@ def cgroup_mounted():
 @unittest.skipUnless(cgroup_mounted(), "slurmd needs a cgroup file system on /sys/fs/cgroup (none is mounted here)")
 class SlurmSweepTest(unittest.TestCase):
     def setUp(self):
-        self.dir = tempfile.mkdtemp(prefix="slurm_test_")
+        make_sweep_folder(self, "slurm_test_")
         self.cluster = OneNodeCluster(os.path.join(self.dir, "cluster"))
         self.cluster.start()
-        self.beds = os.path.join(self.dir, "beds")
-        os.makedirs(self.beds)
-        for m in ("moderate", "gravel"):
-            open(os.path.join(self.beds, f"mascot_{m}_d30.bed"), "w").close()
-        self.out = os.path.join(self.dir, "out")
 
     def tearDown(self):
         self.cluster.stop()
-        if os.environ.get("SWEEP_TEST_KEEP"):
-            print(f"kept {self.dir}")
-        else:
-            shutil.rmtree(self.dir, ignore_errors=True)
+        remove_sweep_folder(self)
 
     def sweep(self, env):
         cmd = [sys.executable, SWEEP, "--land", FAKE, "--bed-dir", self.beds, "--out", self.out,

@@ -19,20 +19,30 @@ SWEEP = os.path.join(ROOT, "scripts", "lib", "sweep.py")
 FAKE = os.path.join(HERE, "fake_land.py")
 
 
+def make_sweep_folder(test, prefix):
+    """A temporary folder for test (its dir), with empty stand-in beds (beds) and an output path (out)."""
+    test.dir = tempfile.mkdtemp(prefix=prefix)
+    test.beds = os.path.join(test.dir, "beds")
+    os.makedirs(test.beds)
+    for m in ("moderate", "gravel"):
+        open(os.path.join(test.beds, f"mascot_{m}_d30.bed"), "w").close()
+    test.out = os.path.join(test.dir, "out")
+
+
+def remove_sweep_folder(test):
+    """The folder of make_sweep_folder removed, unless SWEEP_TEST_KEEP is set."""
+    if os.environ.get("SWEEP_TEST_KEEP"):
+        print(f"kept {test.dir}")
+    else:
+        shutil.rmtree(test.dir, ignore_errors=True)
+
+
 class SweepTest(unittest.TestCase):
     def setUp(self):
-        self.dir = tempfile.mkdtemp(prefix="sweep_test_")
-        self.beds = os.path.join(self.dir, "beds")
-        os.makedirs(self.beds)
-        for m in ("moderate", "gravel"):
-            open(os.path.join(self.beds, f"mascot_{m}_d30.bed"), "w").close()
-        self.out = os.path.join(self.dir, "out")
+        make_sweep_folder(self, "sweep_test_")
 
     def tearDown(self):
-        if os.environ.get("SWEEP_TEST_KEEP"):
-            print(f"kept {self.dir}")
-        else:
-            shutil.rmtree(self.dir)
+        remove_sweep_folder(self)
 
     def sweep(self, *extra, env=None):
         cmd = [sys.executable, SWEEP, "--land", FAKE, "--bed-dir", self.beds, "--out", self.out,

@@ -621,7 +621,11 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source) {
     m.fields.push_back(std::make_shared<GasField>(g));
   }
 
-  finalize_model(m);
+  try {
+    finalize_model(m);
+  } catch (const InputError& e) {  // the model's own checks (a periodic box too short, ...): name the file
+    throw InputError(source + ": " + e.what());
+  }
   sc.scene_kn = m.kn;
   sc.scene_body_kn = m.body_kn;
   sc.scene_dt = m.dt;

@@ -135,6 +135,28 @@ TEST_F(ScenarioInput, WrongTypeIsRefused) {
                  {"walls[0].type", "'torus'", "plane", "sphere_shell"});
 }
 
+TEST_F(ScenarioInput, PeriodicBoxAndGas) {
+  const std::string ok = std::string(kBase) +
+                         "periodic: {x: [-0.05, 0.05], y: [0, 0.04]}\n"
+                         "gas: {density: 1.27, viscosity: 1.983e-5, sound_speed: 515.6, u0: 2, shear: 100}\n";
+  const rt::Scenario sc = rt::load_scenario(write("periodic_gas.yaml", ok));
+  EXPECT_TRUE(sc.model.periodic.x && sc.model.periodic.y);
+  EXPECT_DOUBLE_EQ(sc.model.periodic.length.x(), 0.1);
+  EXPECT_DOUBLE_EQ(sc.model.periodic.lo.y(), 0.0);
+  ASSERT_EQ(sc.model.fields.size(), 1u);
+  EXPECT_STREQ(sc.model.fields[0]->name(), "gas");
+  expect_refused("periodic_short.yaml", std::string(kBase) + "periodic: {x: [0, 0.01]}\n",
+                 {"periodic box along x", "at least"});
+  expect_refused("periodic_order.yaml", std::string(kBase) + "periodic: {x: [0.1, 0.0]}\n", {"periodic.x[1]"});
+  expect_refused("periodic_wall.yaml",
+                 replaced(kBase, "normal: [0, 0, 1]", "normal: [1, 0, 0]") + "periodic: {x: [-0.1, 0.1]}\n",
+                 {"cuts a periodic direction"});
+  expect_refused("gas_missing.yaml", std::string(kBase) + "gas: {density: 1.27}\n", {"gas", "viscosity"});
+  expect_refused("gas_vertical.yaml",
+                 std::string(kBase) + "gas: {density: 1, viscosity: 1e-5, sound_speed: 300, direction: [0, 0, 1]}\n",
+                 {"gas.direction", "horizontal"});
+}
+
 TEST_F(ScenarioInput, MissingStagesAreRefused) {
   expect_refused("no_stages.yaml", replaced(kBase, "stages:\n  - {name: drop, duration: 0.2}\n", ""),
                  {"stages", "missing", "duration"});

@@ -99,7 +99,7 @@ Vec3 GasField::force(double r, double h, const Vec3& v) const {
   GasConstants g;
   g.gamma = p_.gamma;
   g.tp_over_tg = p_.tp_over_tg;
-  g.kn = std::sqrt(kPi * p_.gamma / 2) * p_.viscosity / (p_.density * d * p_.sound_speed);
+  g.kn = knudsen_number(p_.gamma, p_.viscosity, p_.density, d, p_.sound_speed);
   Vec3 f = Vec3::Zero();
   if (p_.drag) f += loth_drag_re(re, ma, g) * (kPi * d * p_.viscosity / 8) * v0;
   const double grad = p_.gradient(h);

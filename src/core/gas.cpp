@@ -13,6 +13,10 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kMaFreeMolecularNegligible = 1e-6;
 }  // namespace
 
+double knudsen_number(double gamma, double viscosity, double density, double diameter, double sound_speed) {
+  return std::sqrt(kPi * gamma / 2) * viscosity / (density * diameter * sound_speed);
+}
+
 double free_molecular_drag(double s, double tp_over_tg) {
   const double s2 = s * s, s4 = s2 * s2;
   return (1 + 2 * s2) * std::exp(-s2) / (s2 * s * std::sqrt(kPi)) + (4 * s4 + 4 * s2 - 1) * std::erf(s) / (2 * s4) +

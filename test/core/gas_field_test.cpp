@@ -10,6 +10,7 @@
 #include "regolith_twin/core/gas.hpp"
 #include "regolith_twin/core/step.hpp"
 #include "regolith_twin/scene/generate.hpp"
+#include "plume_gas.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -17,27 +18,13 @@ namespace {
 using rt::Vec3;
 
 constexpr double kPi = 3.14159265358979323846;
-// The lunar plume gas and grain (docs/scenes.md D).
-constexpr double kRho = 1.27, kMu = 1.983e-5, kC = 515.6, kGamma = 1.33;
-constexpr double kD = 1e-3, kGrainDensity = 2700;
+using rt::test::kPlumeC;
+constexpr double kRho = rt::test::kPlumeRho, kMu = rt::test::kPlumeMu, kC = kPlumeC;
+constexpr double kD = rt::test::kPlumeD, kGrainDensity = rt::test::kPlumeGrainDensity;
 
-rt::GasFlowParams plume_gas() {
-  rt::GasFlowParams p;
-  p.density = kRho;
-  p.viscosity = kMu;
-  p.sound_speed = kC;
-  p.gamma = kGamma;
-  return p;
-}
-
-rt::GasConstants constants() {
-  rt::GasConstants g;
-  g.gamma = kGamma;
-  g.kn = std::sqrt(kPi * kGamma / 2) * kMu / (kRho * kD * kC);
-  return g;
-}
-
-double reynolds(double v) { return kRho * v * kD / kMu; }
+rt::GasFlowParams plume_gas() { return rt::test::plume_gas_flow(); }
+rt::GasConstants constants() { return rt::test::plume_gas_constants(); }
+double reynolds(double v) { return rt::test::plume_reynolds(v); }
 
 TEST(GasField, DragIsLothsCoefficientTimesDynamicPressure) {
   rt::GasFlowParams p = plume_gas();

@@ -7,28 +7,22 @@
 #include <cmath>
 
 #include "regolith_twin/core/gas.hpp"
+#include "plume_gas.hpp"
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kGamma = 1.33;
 
-// The gas of the plume study: Kn of a 1 mm grain, Re and Ma at relative speed v0.
-constexpr double kRho = 1.27, kMu = 1.983e-5, kC = 515.6, kD = 1e-3;
-rt::GasConstants plume_gas() {
-  rt::GasConstants g;
-  g.gamma = kGamma;
-  g.kn = std::sqrt(kPi * kGamma / 2) * kMu / (kRho * kD * kC);
-  return g;
-}
-double reynolds(double v0) { return kRho * v0 * kD / kMu; }
-double mach(double v0) { return v0 / kC; }
+rt::GasConstants plume_gas() { return rt::test::plume_gas_constants(); }
+double reynolds(double v0) { return rt::test::plume_reynolds(v0); }
+double mach(double v0) { return v0 / rt::test::kPlumeC; }
 
 // Kn at a given Re and Ma (the branch comparisons move along Ma at fixed Re).
 rt::GasConstants at(double re, double ma) {
   rt::GasConstants g;
   g.gamma = kGamma;
-  g.kn = std::sqrt(kPi * kGamma / 2) * ma / re;
+  g.kn = std::sqrt(kPi * kGamma / 2) * ma / re;  // Kn = sqrt(pi gamma / 2) Ma / Re
   return g;
 }
 

@@ -16,6 +16,9 @@ struct GasConstants {
   double kn = 0;
 };
 
+// Kn = sqrt(pi gamma / 2) mu_g / (rho_g d c) of a grain of diameter d.
+double knudsen_number(double gamma, double viscosity, double density, double diameter, double sound_speed);
+
 // Free-molecular drag C_D,fm at speed ratio s = Ma sqrt(gamma / 2) > 0
 // (diffuse reflection; the last term is 2 sqrt(pi T_p / T_inf) / (3 s)).
 double free_molecular_drag(double s, double tp_over_tg);

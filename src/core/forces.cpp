@@ -443,7 +443,8 @@ void pair_rows_batched(const Model& m, State& s, int gb, int ge, Vec3* __restric
   uint8_t* __restrict touching = pl.touching.data();
   Vec3* __restrict spring_t = pl.spring_t.data();
   Vec3 image_shift[9];  // periodic boxes: shift of each image code + 4
-  for (int c = 0; c < 9; ++c) image_shift[c] = m.periodic.shift(c - 4);
+  if constexpr (Periodic)
+    for (int c = 0; c < 9; ++c) image_shift[c] = m.periodic.shift(c - 4);
   const GatherSource g{flat(s.pos),     radius,           flat(s.vel), flat(s.omega),
                        flat(s.vel_mid), flat(s.omega_mid), flat(pl.spring_t), flat(pl.spring_r),
                        pl.spring_w.data(),  sqrt_mstar};

@@ -138,6 +138,8 @@ void check_periodic(const Model& m) {
       throw InputError("model: wall '" + w.name +
                        "' cuts a periodic direction: its normal must be perpendicular to the periodic axes");
   }
+  if (m.n_grains >= (1 << 27))  // list entries are packed as 16 j + image code while searching
+    throw InputError("model: a periodic box holds at most 134,217,727 grains");
   if (!m.bodies.empty()) throw InputError("model: rigid bodies are not supported in a periodic box");
   if (m.sleep.enabled) throw InputError("model: sleep.enabled is not supported in a periodic box");
   if (m.free_flight.enabled) throw InputError("model: free_flight.enabled is not supported in a periodic box");

@@ -64,6 +64,17 @@ bool trigger(const std::string& name, std::string* message = nullptr) {
   return t.response.success;
 }
 
+// ros::service::call asks the master for the service on every call, and two
+// such lookups at once race inside roscpp (ThreadSanitizer reports it for a
+// program that uses roscpp alone). Tests that call from two threads at once
+// therefore open persistent clients first, one per thread: a persistent
+// client looks the service up on its first call only.
+template <class Service>
+ros::ServiceClient persistent_client(const std::string& name) {
+  ros::NodeHandle nh;
+  return nh.serviceClient<Service>(srv(name), true);
+}
+
 regolith_twin::Step::Response step(long n) {
   regolith_twin::Step s;
   s.request.steps = n;
@@ -277,18 +288,27 @@ TEST(TwinNodeServices, BadRequestsGetErrors_AndTheNodeGoesOn) {
 }
 
 TEST(TwinNodeServices, ALongStepIsCancelledByPause) {
-  ASSERT_TRUE(trigger("pause"));
+  auto pause = persistent_client<std_srvs::Trigger>("pause");
+  auto stepper = persistent_client<regolith_twin::Step>("step");
+  std_srvs::Trigger p;
+  ASSERT_TRUE(pause.call(p));
+  ASSERT_TRUE(p.response.success);
+  regolith_twin::Step one;
+  one.request.steps = 1;
+  ASSERT_TRUE(stepper.call(one));
+  ASSERT_TRUE(one.response.success) << one.response.message;
   const double t0 = g_node->sim_time();
   regolith_twin::Step::Response r;
-  std::thread caller([&r] {
+  std::thread caller([&r, &stepper] {
     regolith_twin::Step s;
     s.request.steps = 100000000;  // far longer than the test
-    EXPECT_TRUE(ros::service::call(srv("step"), s));
+    EXPECT_TRUE(stepper.call(s));
     r = s.response;
   });
   ros::WallDuration(1.0).sleep();
-  std::string msg;
-  EXPECT_TRUE(trigger("pause", &msg));
+  EXPECT_TRUE(pause.call(p));
+  EXPECT_TRUE(p.response.success);
+  const std::string& msg = p.response.message;
   EXPECT_NE(msg.find("cancelled"), std::string::npos) << msg;
   caller.join();  // the step request answers at once
   EXPECT_FALSE(r.success);
@@ -309,20 +329,33 @@ TEST(TwinNodeServices, ABlockingCheckpointPathDoesNotStopTheNode) {
   ASSERT_NE(mkdtemp(dir), nullptr);
   const std::string fifo = std::string(dir) + "/state.ckpt";
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  auto loader_client = persistent_client<regolith_twin::Checkpoint>("load_checkpoint");
+  auto stepper = persistent_client<regolith_twin::Step>("step");
+  auto pause = persistent_client<std_srvs::Trigger>("pause");
   regolith_twin::Checkpoint c;
+  c.request.path = std::string(dir) + "/absent.ckpt";  // opens the link; refused
+  ASSERT_TRUE(loader_client.call(c));
+  EXPECT_FALSE(c.response.success);
+  regolith_twin::Step s;
+  s.request.steps = 1;
+  ASSERT_TRUE(stepper.call(s));
+  std_srvs::Trigger p;
+  ASSERT_TRUE(pause.call(p));
   c.request.path = fifo;
   std::atomic<bool> answered{false};
   std::thread loader([&] {
-    EXPECT_TRUE(ros::service::call(srv("load_checkpoint"), c));
+    EXPECT_TRUE(loader_client.call(c));
     answered = true;
   });
   ros::WallDuration(0.5).sleep();
   EXPECT_FALSE(answered);
   const double t = g_node->sim_time();
-  const auto r = step(5);  // served while the load waits
-  EXPECT_TRUE(r.success) << r.message;
-  EXPECT_GT(r.sim_time, t);
-  EXPECT_TRUE(trigger("pause"));
+  s.request.steps = 5;
+  EXPECT_TRUE(stepper.call(s));  // served while the load waits
+  EXPECT_TRUE(s.response.success) << s.response.message;
+  EXPECT_GT(s.response.sim_time, t);
+  EXPECT_TRUE(pause.call(p));
+  EXPECT_TRUE(p.response.success);
   // Writers come and go with nothing written: the load reads an empty file and refuses it.
   for (int k = 0; k < 1000 && !answered; ++k) {
     const int fd = open(fifo.c_str(), O_WRONLY | O_NONBLOCK);  // succeeds only while a reader waits

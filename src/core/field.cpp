@@ -79,35 +79,49 @@ GasField::GasField(const GasFlowParams& p) : p_(p) {
   need(p.u_log == 0 || (std::isfinite(p.h_log) && p.h_log > 0), "h_log", p.h_log, "finite, > 0 m with u_log");
   need(std::isfinite(p.anchor_z), "anchor_z", p.anchor_z, "finite");
   need(p.anchor_slot >= -1, "anchor_slot", p.anchor_slot, ">= -1");
+  need(std::isfinite(p.density_length) && p.density_length >= 0, "density_length", p.density_length,
+       "finite, >= 0 m");
+  if (!finite(p.nozzle)) throw InputError("gas field: the nozzle position must be finite");
   if (!finite(p.direction) || p.direction.z() != 0 || !(p.direction.norm() > 0))
     throw InputError("gas field: the flow direction must be a finite horizontal vector (z = 0), not zero");
   p_.direction = p.direction.normalized();
 }
 
 double GasField::anchor(const State& s) const {
-  return p_.anchor_slot >= 0 && p_.anchor_slot < int(s.field_values.size()) ? s.field_values[p_.anchor_slot]
-                                                                             : p_.anchor_z;
+  return p_.anchor_slot >= 0 ? s.field_values[p_.anchor_slot] : p_.anchor_z;  // size checked by prime()
 }
 
-Vec3 GasField::force(double r, double h, const Vec3& v) const {
+Vec3 GasField::force_at(double r, double h, const Vec3& x, const Vec3& v) const {
+  Vec3 e = p_.direction;
+  double rho = p_.density;
+  if (p_.radial) {
+    const Vec3 out(x.x() - p_.nozzle.x(), x.y() - p_.nozzle.y(), 0);
+    const double n = out.norm();
+    e = n > 0 ? Vec3(out / n) : Vec3(Vec3::Zero());
+  }
+  if (p_.density_length > 0) rho /= 1 + (x - p_.nozzle).squaredNorm() / (p_.density_length * p_.density_length);
+  return force(r, h, v, e, rho);
+}
+
+Vec3 GasField::force(double r, double h, const Vec3& v, const Vec3& e, double rho) const {
   constexpr double kPi = 3.14159265358979323846;
   const double d = 2 * r;
   const double u = p_.velocity(h);
-  const Vec3 v0 = u * p_.direction - v;
+  const Vec3 v0 = u * e - v;
   const double speed = v0.norm();
-  const double re = p_.density * speed * d / p_.viscosity, ma = speed / p_.sound_speed;
+  const double re = rho * speed * d / p_.viscosity, ma = speed / p_.sound_speed;
   GasConstants g;
   g.gamma = p_.gamma;
   g.tp_over_tg = p_.tp_over_tg;
-  g.kn = knudsen_number(p_.gamma, p_.viscosity, p_.density, d, p_.sound_speed);
+  g.kn = knudsen_number(p_.gamma, p_.viscosity, rho, d, p_.sound_speed);
   Vec3 f = Vec3::Zero();
   if (p_.drag) f += loth_drag_re(re, ma, g) * (kPi * d * p_.viscosity / 8) * v0;
   const double grad = p_.gradient(h);
-  const double along = v0.dot(p_.direction);
+  const double along = v0.dot(e);
   if (p_.lift && speed > 0 && grad != 0 && along != 0) {
     const double omega_star = std::abs(grad) * d / speed;
     const double sign = (along > 0) == (grad > 0) ? 1.0 : -1.0;
-    f.z() += sign * loth_lift(re, omega_star) * (kPi * d * d * p_.density / 8) * speed * speed;
+    f.z() += sign * loth_lift(re, omega_star) * (kPi * d * d * rho / 8) * speed * speed;
   }
   return f;
 }
@@ -120,11 +134,12 @@ void GasField::apply(const Model& m, State& s, int begin, int end) const {
   const Vec3* __restrict vel = s.vel.data();
   Vec3* __restrict force = s.force.data();
   const double z0 = anchor(s);
+  const bool local = p_.radial || p_.density_length > 0;
   for (int i = begin; i < end; ++i) {
     if (inv_mass[i] == 0) continue;  // glued grain
     const double h = pos[i].z() - z0;
     if (!(h > 0)) continue;  // at or below the anchoring plane: no gas
-    force[i] += this->force(radius[i], h, vel[i]);
+    force[i] += local ? force_at(radius[i], h, pos[i], vel[i]) : this->force(radius[i], h, vel[i]);
   }
 }
 

@@ -16,6 +16,11 @@
 namespace rt {
 
 void prime(const Model& m, State& s) {
+  for (const auto& f : m.fields)
+    if (f->state_values() > int(s.field_values.size()))
+      throw InputError(std::string("field '") + f->name() + "' reads " + std::to_string(f->state_values()) +
+                       " entries of the state's field values; the state holds " +
+                       std::to_string(s.field_values.size()));
   build_neighbour_lists(m, s);
   s.contact_count.assign(m.n_grains, 0);  // the guard's counts (sized here: steps allocate nothing)
   // Forces of the current state without advancing any contact history: the

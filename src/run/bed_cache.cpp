@@ -18,6 +18,10 @@ std::string bed_key(const Model& m, const State& s, const std::vector<int>& plac
   for (const auto& mat : m.materials) {
     const double v[] = {mat.density, mat.eps_n, mat.eps_t, mat.mu_s, mat.mu_r, mat.mu_t, mat.beta, mat.young};
     h = fnv1a(v, sizeof v, h);
+    if (mat.kt_over_kn != Material().kt_over_kn || mat.ct_over_cn > 0) {  // (default laws keep their keys)
+      const double t[] = {mat.kt_over_kn, mat.ct_over_cn};
+      h = fnv1a(t, sizeof t, h);
+    }
   }
   for (const auto& w : m.walls) {
     const double v[] = {w.origin.x(), w.origin.y(), w.origin.z(), w.axis.x(), w.axis.y(), w.axis.z(), w.radius, w.length};
@@ -78,9 +82,11 @@ RelaxedBed relax_bed(Scenario& sc, const State& s0, const std::vector<int>& plac
   // stiffness schedule: a bed is prepared by the same dynamics whatever the
   // scene later skips, and the stages' settings (gravity, stiffness scale) do not stay in the scene's
   // model, as they do not when the bed comes from the cache.
+  // Fields (a gas) are off too: a bed settles by itself, the scene's gas acts on the settled bed.
   Scenario relax = sc;
   relax.model.sleep.enabled = false;
   relax.model.schedule.enabled = false;
+  relax.model.fields.clear();
   const RunReport rr = run_scenario(relax, out.state, ro);
   if (rr.status != "ok") throw BlowUpError("bed relaxation: " + rr.message);
   if (!opt.quiet)

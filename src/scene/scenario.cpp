@@ -598,7 +598,8 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source) {
   // A gas flowing over the grains (docs/model.md §10.1).
   if (const YAML::Node gas = rd.map(root, "", "gas", false)) {
     rd.only(gas, "gas", {"density", "viscosity", "sound_speed", "gamma", "temperature_ratio", "direction", "u0",
-                         "shear", "u_log", "h_log", "anchor_z", "drag", "lift"});
+                         "shear", "u_log", "h_log", "anchor_z", "drag", "lift", "radial", "nozzle",
+                         "density_length"});
     GasFlowParams g;
     g.density = rd.number(gas, "gas", "density", 0, 0, kInf, true);
     g.viscosity = rd.number(gas, "gas", "viscosity", 0, 0, kInf, true);
@@ -618,6 +619,11 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source) {
     g.anchor_z = rd.number(gas, "gas", "anchor_z", 0, -kInf, kInf);
     g.drag = rd.boolean(gas, "gas", "drag", true);
     g.lift = rd.boolean(gas, "gas", "lift", true);
+    g.radial = rd.boolean(gas, "gas", "radial", false);
+    g.nozzle = rd.vec3(gas, "gas", "nozzle", Vec3::Zero());
+    g.density_length = rd.number(gas, "gas", "density_length", 0, 0, kInf);
+    if ((g.radial || g.density_length > 0) && !YamlReader::get(gas, "nozzle"))
+      rd.fail("gas.nozzle", "required with radial or density_length: the nozzle's position [x, y, z] (m)");
     m.fields.push_back(std::make_shared<GasField>(g));
   }
 

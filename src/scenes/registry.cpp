@@ -2,6 +2,7 @@
 #include "regolith_twin/scenes/registry.hpp"
 
 #include "regolith_twin/scenes/landing/landing_scene.hpp"
+#include "regolith_twin/scenes/plume/plume_scene.hpp"
 #include "regolith_twin/scenes/sampler/sampler_scene.hpp"
 
 namespace rt {
@@ -10,6 +11,7 @@ std::vector<std::shared_ptr<const SceneKind>> builtin_scene_kinds() {
   return {
       landing_kind(),  // MASCOT landing: `landing:` (docs/scenes.md A)
       sampler_kind(),  // Hayabusa2 sampler shot: `sampler:` (docs/scenes.md B)
+      plume_kind(),    // plume erosion in a periodic box: `plume:` (docs/scenes.md D)
   };
 }
 

@@ -163,6 +163,43 @@ TEST(GasField, OnlyAboveTheAnchoringPlane) {
   q.s.field_values[0] = 0.5;
   rt::step(q.m, q.s);
   EXPECT_GT(q.s.vel[0].x(), 0);
+  // A state without the slot is refused before the first step, naming the field.
+  OneGrain r = one_grain(p, Vec3::Zero(), 1e-4);
+  r.s.field_values.clear();
+  r.s.forces_valid = false;
+  try {
+    rt::step(r.m, r.s);
+    ADD_FAILURE() << "a state without the anchoring plane's slot was stepped";
+  } catch (const rt::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'gas' reads 1 entries"), std::string::npos) << e.what();
+  }
+}
+
+TEST(GasField, ANozzlesPlumeFlowsOutwardAndThinsWithDistance) {
+  rt::GasFlowParams p = plume_gas();
+  p.u0 = 50;
+  p.radial = true;
+  p.nozzle = Vec3(1, 2, 3);
+  p.density_length = 0.5;
+  const rt::GasField f(p);
+  const double r = kD / 2, h = 0.01;
+  // Outward from the point below the nozzle, in any horizontal direction.
+  const Vec3 east = f.force_at(r, h, Vec3(2, 2, 0), Vec3::Zero());
+  const Vec3 north = f.force_at(r, h, Vec3(1, 3, 0), Vec3::Zero());
+  EXPECT_GT(east.x(), 0);
+  EXPECT_EQ(east.y(), 0);
+  EXPECT_GT(north.y(), 0);
+  EXPECT_EQ(north.x(), 0);
+  EXPECT_EQ(f.force_at(r, h, Vec3(1, 2, 0), Vec3::Zero()), Vec3::Zero());  // right below: no flow
+  // At r = L the density is half: the same force as a uniform gas of half the density.
+  rt::GasFlowParams q = plume_gas();
+  q.u0 = 50;
+  q.density = p.density / 2;
+  const Vec3 at_l = f.force_at(r, h, p.nozzle + Vec3(0.3, 0.4, 0), Vec3::Zero());  // |x - nozzle| = 0.5
+  const Vec3 half = rt::GasField(q).force(r, h, Vec3::Zero());
+  EXPECT_NEAR(at_l.x(), 0.6 * half.x(), 1e-15 * half.norm());
+  EXPECT_NEAR(at_l.y(), 0.8 * half.x(), 1e-15 * half.norm());
+  EXPECT_NEAR(at_l.z(), half.z(), 1e-15 * half.norm());
 }
 
 TEST(GasField, BadParametersAreRefused) {

@@ -23,6 +23,9 @@ class Field {
   virtual ~Field();
   virtual const char* name() const = 0;
   virtual void apply(const Model& m, State& s, int begin, int end) const = 0;
+  // How many entries of State::field_values the field reads (prime() refuses
+  // a state with fewer).
+  virtual int state_values() const { return 0; }
 };
 
 // Uniform acceleration a: force m_i a on every free grain.
@@ -62,7 +65,8 @@ class LinearDragField final : public Field {
 // with omega* = |dU/dh| d / |v0| (downward for a grain that outruns the gas).
 // No fluid torque. U(h) = u0 + shear h + u_log ln(1 + h / h_log).
 // The plane's height is s.field_values[anchor_slot] when anchor_slot >= 0
-// (a scene moves it as the bed erodes), else anchor_z.
+// (a scene moves it as the bed erodes; the state must hold that entry), else
+// anchor_z.
 struct GasFlowParams {
   double density = 0;       // rho_g, kg/m^3 (> 0)
   double viscosity = 0;     // mu_g, Pa s (> 0)
@@ -77,6 +81,13 @@ struct GasFlowParams {
   double anchor_z = 0;      // m
   int anchor_slot = -1;     // index into State::field_values, or -1
   bool drag = true, lift = true;
+  // A nozzle's plume instead of a uniform flow: with `radial`, e is the
+  // horizontal unit vector from the point below the nozzle to the grain (no
+  // flow right below it); with density_length L > 0 the density falls off
+  // with the distance r from the nozzle as rho_g / (1 + r^2 / L^2).
+  bool radial = false;
+  Vec3 nozzle = Vec3::Zero();  // m
+  double density_length = 0;   // m (<= 0: uniform density)
 
   double velocity(double h) const;  // U(h), m/s
   double gradient(double h) const;  // dU/dh, 1/s
@@ -87,13 +98,17 @@ class GasField final : public Field {
   explicit GasField(const GasFlowParams& p);  // InputError naming the value out of range
   const char* name() const override { return "gas"; }
   void apply(const Model& m, State& s, int begin, int end) const override;
+  int state_values() const override { return p_.anchor_slot + 1; }
   const GasFlowParams& params() const { return p_; }
   // The anchoring plane's height in state s, m.
   double anchor(const State& s) const;
-  // Drag and lift on a grain of radius r at height h above the plane moving at v, N.
-  Vec3 force(double r, double h, const Vec3& v) const;
+  // Drag and lift on a grain of radius r at height h above the plane moving
+  // at v, N: in the uniform flow, and at position x (radial flow, density falloff).
+  Vec3 force(double r, double h, const Vec3& v) const { return force(r, h, v, p_.direction, p_.density); }
+  Vec3 force_at(double r, double h, const Vec3& x, const Vec3& v) const;
 
  private:
+  Vec3 force(double r, double h, const Vec3& v, const Vec3& e, double rho) const;
   GasFlowParams p_;
 };
 

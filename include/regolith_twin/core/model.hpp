@@ -208,6 +208,9 @@ struct Model {
   // Per-grain force fields added after the contacts (field.hpp), in this
   // order. Shared, immutable: copies of the Model share them. Empty: none.
   std::vector<std::shared_ptr<const Field>> fields;
+  // Grain–grain contacts on (the default). Off: the pair list stays empty and
+  // grains touch only walls and bodies (a collisionless study, docs/model.md §11).
+  bool grain_contacts = true;
 
   // --- integration ---
   double dt = 1e-5;                    // s

@@ -24,7 +24,7 @@ struct RelaxedBed {
 std::string bed_key(const Model& m, const State& s, const std::vector<int>& placed);
 
 // The bed of s relaxed by the scenario's stages (sc.model as the stages
-// leave it), or the cached one (sc.model untouched). `label` prefixes the
+// leave it, without its fields, sleeping or stiffness schedule), or the cached one (sc.model untouched). `label` prefixes the
 // progress lines. Throws InputError without stages, BlowUpError if the
 // relaxation fails.
 RelaxedBed relax_bed(Scenario& sc, const State& s, const std::vector<int>& placed, const SceneOptions& opt,

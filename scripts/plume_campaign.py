@@ -1,0 +1,147 @@
+#!/usr/bin/python3
+"""Plume-erosion campaign (docs/scenes.md D, docs/validation.md "Plume erosion").
+
+  plume_campaign.py BIN OUT DOCS calibrate        bisection on the gas scale u0 (seed 1)
+  plume_campaign.py BIN OUT DOCS run [RUN...]     runs (default: all), each seed in turn
+  plume_campaign.py BIN OUT DOCS report           docs/validation/plume/report.md + plots
+
+A finished run's summary.json and its N(t) every millisecond are copied to
+DOCS/RUN/ (committed: a campaign resumes on any machine; a run whose copy
+exists is not run again unless PLUME_RERUN=1).
+"""
+import csv
+import json
+import os
+import subprocess
+import sys
+import time
+
+CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "plume_erosion.yaml")
+SEEDS = [1, 2, 3]
+MAT = ["materials.regolith", "materials.floor"]
+
+
+def both(key, value):
+    return ["%s.%s=%s" % (m, key, value) for m in MAT]
+
+
+# name: (overrides, seeds, what it compares with)
+RUNS = {
+    "base": ([], SEEDS, "calibrated case: depletion at about 0.15 s"),
+    "upward": (["plume.plane_motion=upward"], SEEDS, "planes moved by upward crossings only (decision check)"),
+    "collisionless": (["plume.collisionless=true"], SEEDS, "no grain-grain contacts: collisions' effect on the rate"),
+    "nondissipative": (both("eps_n", 1) + both("mu_s", 0), SEEDS, "eps = 1, mu = 0"),
+    "pen2": (["plume.penetration_depth=2"], SEEDS, "penetration depth 2 d"),
+    "pen6": (["plume.penetration_depth=6"], SEEDS, "penetration depth 6 d"),
+    "ero16": (["plume.erosion_height=16"], SEEDS, "erosion plane 16 d above the bed"),
+    "box2": (["periodic.x=[0,0.020]", "periodic.y=[0,0.010]", "grains.0.fill.hi=[0.020,0.010,0.030]",
+              "grains.0.fill.count=3200"], SEEDS, "box twice as long and wide (3200 grains)"),
+    "deep": (["grains.0.fill.hi=[0.010,0.005,0.060]", "grains.0.fill.count=1600"], SEEDS, "bed twice as deep"),
+    "k8e4": (["contact.kn=8e4"], SEEDS, "k_n = 8e4 N/m"),
+    "k8e5": (["contact.kn=8e5"], SEEDS, "k_n = 8e5 N/m"),
+    "k8e6": (["contact.kn=8e6"], [1], "k_n = 8e6 N/m (one seed)"),
+    "splash": (["plume.splash.speed=1.0", "plume.splash.angle_deg=15", "plume.duration=0.05"], SEEDS,
+               "one grain at 1 m/s, 15 degrees, into the bed; no gas"),
+}
+for e in (0.6, 0.8):
+    for mu in (0.2, 0.5, 0.8, 1.4):
+        if (e, mu) != (0.8, 0.2):
+            RUNS["e%g_mu%g" % (e, mu)] = (both("eps_n", e) + both("mu_s", mu), SEEDS, "eps = %g, mu = %g" % (e, mu))
+
+
+def run_one(bin_dir, out, docs, name, seed, extra=(), tag=None):
+    tag = tag or "%s_s%d" % (name, seed)
+    keep = os.path.join(docs, tag)
+    if os.path.exists(os.path.join(keep, "summary.json")) and os.environ.get("PLUME_RERUN") != "1":
+        return json.load(open(os.path.join(keep, "summary.json")))
+    overrides = list(RUNS[name][0]) if name in RUNS else []
+    overrides += list(extra) + ["seed=%d" % seed]
+    d = os.path.join(out, tag)
+    cmd = [os.path.join(bin_dir, "regolith_sim"), CONFIG, "--threads", "1", "--out", d, "--quiet"]
+    for o in overrides:
+        cmd += ["--set", o]
+    t0 = time.time()
+    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if r.returncode != 0:
+        sys.stderr.write(r.stdout[-3000:])
+        print("%s: FAILED (exit %d; the campaign goes on)" % (tag, r.returncode), flush=True)
+        return None
+    wall = time.time() - t0
+    os.makedirs(keep, exist_ok=True)
+    s = json.load(open(os.path.join(d, "summary.json")))
+    s["campaign"] = {"run": name, "seed": seed, "overrides": overrides, "wall_seconds": wall}
+    with open(os.path.join(keep, "summary.json"), "w") as f:
+        json.dump(s, f, indent=1)
+    with open(os.path.join(d, "erosion.csv")) as f, open(os.path.join(keep, "n_of_t.csv"), "w") as g:
+        rows = [r for r in csv.reader(x for x in f if not x.startswith("#"))]
+        g.write("t,above,erosion_plane,up_per_step,down_per_step,pairs_per_grain,touching_fraction\n")
+        last = -1.0
+        for r in rows[1:]:
+            t = float(r[0])
+            if t - last >= 1e-3 - 1e-9 or r is rows[-1]:
+                g.write(",".join([r[0], r[2], r[4], r[5], r[6], r[7], r[8]]) + "\n")
+                last = t
+    print("%s: %s (%.0f s)" % (tag, line(s), wall), flush=True)
+    return s
+
+
+def line(s):
+    e = s["observers"]["erosion"]
+    return "N %d/%d, depleted at %.4g s, rate %.4g grains/s, up %d down %d" % (
+        e["grains_above"], e["grains"], e["depleted_at"], e["erosion_rate"], e["upward_crossings"],
+        e["downward_crossings"])
+
+
+def calibrate(bin_dir, out, docs):
+    """Bisection on u0 (u_log = 0.3 u0) for depletion at 0.15 s on seed 1."""
+    target, lo, hi = 0.15, 8.0, 24.0
+    steps = []
+
+    def t_dep(u):
+        tag = "cal_u%.4g" % u
+        s = run_one(bin_dir, out, os.path.join(docs, "calibration"), "base", 1,
+                    ["gas.u0=%.6g" % u, "gas.u_log=%.6g" % (0.3 * u), "plume.duration=0.25"], tag)
+        if s is None:
+            raise SystemExit("calibration run %s failed" % tag)
+        t = s["observers"]["erosion"]["depleted_at"]
+        steps.append({"u0": u, "depleted_at": t})
+        return t if t >= 0 else 1e9
+
+    for _ in range(7):
+        mid = 0.5 * (lo + hi)
+        if t_dep(mid) > target:
+            lo = mid
+        else:
+            hi = mid
+    best = min(steps, key=lambda x: abs(x["depleted_at"] - target))
+    res = {"target_depleted_at": target, "steps": steps, "u0": best["u0"], "u_log": 0.3 * best["u0"]}
+    with open(os.path.join(docs, "calibration.json"), "w") as f:
+        json.dump(res, f, indent=1)
+    print("calibrated: u0 = %.4g m/s (depleted at %.4g s); set gas.u0 and gas.u_log in %s" %
+          (best["u0"], best["depleted_at"], CONFIG))
+
+
+def main():
+    if len(sys.argv) < 5:
+        raise SystemExit(__doc__)
+    bin_dir, out, docs, cmd = sys.argv[1:5]
+    os.makedirs(out, exist_ok=True)
+    os.makedirs(docs, exist_ok=True)
+    if cmd == "calibrate":
+        calibrate(bin_dir, out, docs)
+    elif cmd == "run":
+        names = sys.argv[5:] or list(RUNS)
+        for n in names:
+            if n not in RUNS:
+                raise SystemExit("unknown run '%s' (%s)" % (n, " ".join(RUNS)))
+            for seed in RUNS[n][1]:
+                run_one(bin_dir, out, docs, n, seed)
+    elif cmd == "report":
+        import plume_report
+        plume_report.report(docs, RUNS)
+    else:
+        raise SystemExit(__doc__)
+
+
+if __name__ == "__main__":
+    main()

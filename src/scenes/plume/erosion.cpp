@@ -1,0 +1,252 @@
+// Plume erosion measurement (see erosion.hpp; docs/scenes.md D).
+#include "regolith_twin/scenes/plume/erosion.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "regolith_twin/core/model.hpp"
+#include "regolith_twin/run/series.hpp"
+
+namespace rt {
+
+void ErosionObserver::prepare(Model& m, State& s) {
+  const int need = std::max(p_.anchor_slot, p_.erosion_slot) + 1;
+  if (int(s.field_values.size()) < need) s.field_values.resize(need, 0.0);
+  s.field_values[p_.anchor_slot] = p_.anchor;
+  s.field_values[p_.erosion_slot] = p_.erosion;
+  n_grains_ = m.n_grains;
+  if (p_.hold_below_anchor) {
+    inv_mass_ = m.grain_inv_mass;
+    inv_inertia_ = m.grain_inv_inertia;
+    held_.assign(m.n_grains, 0);
+    hold(m, s, true);
+  }
+}
+
+// Collisionless study: hold the grains below the anchoring plane, free those above it.
+void ErosionObserver::hold(Model& m, State& s, bool first) {
+  const double a = s.field_values[p_.anchor_slot];
+  bool changed = false;
+  for (int i = 0; i < m.n_grains; ++i) {
+    if (inv_mass_[i] == 0) continue;  // glued from the start: stays glued
+    const bool below = s.pos[i].z() <= a;
+    if (below && !held_[i]) {
+      held_[i] = 1;
+      m.grain_fixed[i] = 1;
+      m.grain_inv_mass[i] = 0;
+      m.grain_inv_inertia[i] = 0;
+      s.vel[i].setZero();
+      s.omega[i].setZero();
+      changed = true;
+    } else if (!below && held_[i]) {
+      held_[i] = 0;
+      m.grain_fixed[i] = 0;
+      m.grain_inv_mass[i] = inv_mass_[i];
+      m.grain_inv_inertia[i] = inv_inertia_[i];
+      changed = true;
+    }
+  }
+  if (changed) {
+    s.rebuild_requested = true;
+    if (first) s.forces_valid = false;
+  }
+}
+
+void ErosionObserver::start(const Model& m, const State& s) {
+  const double e = s.field_values[p_.erosion_slot];
+  is_above_.assign(m.n_grains, 0);
+  above_now_ = 0;
+  for (int i = 0; i < m.n_grains; ++i) {
+    is_above_[i] = s.pos[i].z() > e;
+    above_now_ += is_above_[i];
+  }
+  const int w = std::max(1, p_.window);
+  ring_up_.assign(w, 0);
+  ring_down_.assign(w, 0);
+  ring_pairs_.assign(w, 0);
+  ring_touch_.assign(w, 0);
+  ring_n_.assign(w, 0);
+  n_series_.assign(1, above_now_);
+  t_series_.assign(1, s.time);
+  ErosionRow r;
+  r.t = s.time;
+  r.step = s.step;
+  r.above = above_now_;
+  r.anchor = s.field_values[p_.anchor_slot];
+  r.erosion = e;
+  rows_.assign(1, r);
+}
+
+void ErosionObserver::count(const Model& m, const State& s, int& pairs, int& touching) const {
+  pairs = 0;
+  touching = 0;
+  if (above_now_ == 0 || !m.grain_contacts || s.pairs.row_start.size() != size_t(m.n_grains) + 1) return;
+  std::vector<uint8_t> touched;  // only when some grain is above: small
+  touched.assign(m.n_grains, 0);
+  const PairList& pl = s.pairs;
+  for (int i = 0; i < m.n_grains; ++i) {
+    if (!is_above_[i]) continue;
+    for (int k = pl.row_start[i]; k < pl.row_start[i + 1]; ++k) {
+      const int j = pl.partner[k];
+      if (!pl.touching[k] || !is_above_[j]) continue;
+      ++pairs;
+      touched[i] = touched[j] = 1;
+    }
+  }
+  for (int i = 0; i < m.n_grains; ++i) touching += touched[i];
+}
+
+bool ErosionObserver::after_step(Model& m, State& s) {
+  double& anchor = s.field_values[p_.anchor_slot];
+  double& erosion = s.field_values[p_.erosion_slot];
+  int up = 0, down = 0;
+  above_now_ = 0;
+  for (int i = 0; i < m.n_grains; ++i) {
+    const uint8_t a = s.pos[i].z() > erosion;
+    up += a && !is_above_[i];
+    down += !a && is_above_[i];
+    is_above_[i] = a;
+    above_now_ += a;
+  }
+  int pairs = 0, touching = 0;
+  count(m, s, pairs, touching);
+  total_up_ += up;
+  total_down_ += down;
+  if (down > 0 && t_first_down_ < 0) t_first_down_ = s.time;
+  if (above_now_ >= p_.depleted_fraction * n_grains_ && t_depleted_ < 0) t_depleted_ = s.time;
+  if (above_now_ == n_grains_ && t_all_ < 0) t_all_ = s.time;
+  // Both planes follow the surface (erosion.hpp).
+  const int lost = p_.motion == PlaneMotion::Net ? up - down : p_.motion == PlaneMotion::Upward ? up : 0;
+  if (lost != 0) {
+    const double dz = lost * p_.grain_volume / (p_.bed_fraction * p_.area);
+    anchor -= dz;
+    erosion -= dz;
+  }
+  if (p_.hold_below_anchor) hold(m, s, false);
+  // Moving sums over the last `window` steps.
+  const size_t k = size_t(ring_pos_ % long(ring_up_.size()));
+  sum_up_ += up - ring_up_[k];
+  sum_down_ += down - ring_down_[k];
+  sum_pairs_ += pairs - ring_pairs_[k];
+  sum_touch_ += touching - ring_touch_[k];
+  sum_n_ += above_now_ - ring_n_[k];
+  ring_up_[k] = up;
+  ring_down_[k] = down;
+  ring_pairs_[k] = pairs;
+  ring_touch_[k] = touching;
+  ring_n_[k] = above_now_;
+  ++ring_pos_;
+  ++steps_;
+  n_series_.push_back(above_now_);
+  t_series_.push_back(s.time);
+  const long w = std::min<long>(ring_pos_, long(ring_up_.size()));
+  ErosionRow r;
+  r.t = s.time;
+  r.step = s.step;
+  r.above = above_now_;
+  r.anchor = anchor;
+  r.erosion = erosion;
+  r.up = double(sum_up_) / w;
+  r.down = double(sum_down_) / w;
+  r.pairs_per_grain = sum_n_ > 0 ? double(sum_pairs_) / sum_n_ : 0;
+  r.touching_fraction = sum_n_ > 0 ? double(sum_touch_) / sum_n_ : 0;
+  max_pairs_per_grain_ = std::max(max_pairs_per_grain_, r.pairs_per_grain);
+  max_up_ = std::max(max_up_, r.up);
+  if (steps_ % std::max(1, p_.sample_every) == 0) rows_.push_back(r);
+  return false;
+}
+
+void ErosionObserver::columns(std::vector<std::string>& out) const {
+  for (const char* c : {"above", "anchor_plane", "erosion_plane", "up_per_step", "down_per_step", "pairs_per_grain",
+                        "touching_fraction"})
+    out.push_back(c);
+}
+
+void ErosionObserver::row(const Model& m, const State& s, std::vector<double>& out) const {
+  const ErosionRow& r = rows_.back();
+  const bool now = r.step == s.step;
+  out.push_back(above_now_);
+  out.push_back(s.field_values.size() > size_t(p_.anchor_slot) ? s.field_values[p_.anchor_slot] : p_.anchor);
+  out.push_back(s.field_values.size() > size_t(p_.erosion_slot) ? s.field_values[p_.erosion_slot] : p_.erosion);
+  out.push_back(now ? r.up : 0);
+  out.push_back(now ? r.down : 0);
+  out.push_back(now ? r.pairs_per_grain : 0);
+  out.push_back(now ? r.touching_fraction : 0);
+}
+
+void ErosionObserver::finish(Model& m, State& s) {
+  if (!rows_.empty() && rows_.back().step != s.step && steps_ > 0) {
+    // the last step's row, for the file's end
+    ErosionRow r = rows_.back();
+    r.t = s.time;
+    r.step = s.step;
+    r.above = above_now_;
+    r.anchor = s.field_values[p_.anchor_slot];
+    r.erosion = s.field_values[p_.erosion_slot];
+    rows_.push_back(r);
+  }
+  // Erosion rate: one least-squares line through N(t) over the non-depleted phase.
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  long n = 0;
+  for (size_t k = 0; k < n_series_.size(); ++k) {
+    if (t_depleted_ >= 0 && t_series_[k] > t_depleted_) break;
+    const double x = t_series_[k] - t_series_[0], y = n_series_[k];
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+    ++n;
+  }
+  const double den = n * sxx - sx * sx;
+  rate_ = n > 1 && den > 0 ? (n * sxy - sx * sy) / den : 0;
+  rate_intercept_ = n > 0 ? (sy - rate_ * sx) / n : 0;
+  if (p_.hold_below_anchor) {  // the model's masses back as they were
+    for (int i = 0; i < m.n_grains && i < int(held_.size()); ++i)
+      if (held_[i]) {
+        m.grain_fixed[i] = 0;
+        m.grain_inv_mass[i] = inv_mass_[i];
+        m.grain_inv_inertia[i] = inv_inertia_[i];
+        held_[i] = 0;
+      }
+    s.rebuild_requested = true;
+    s.forces_valid = false;
+  }
+}
+
+void ErosionObserver::summary(JsonObject& out) const {
+  JsonObject o;
+  o.num("grains_above", above_now_).num("grains", n_grains_);
+  o.num("depleted_at", t_depleted_).num("depleted_fraction", p_.depleted_fraction).num("all_above_at", t_all_);
+  o.num("sedimentation_from", t_first_down_);
+  o.num("erosion_rate", rate_).num("erosion_rate_per_area", rate_per_area()).num("fit_intercept", rate_intercept_);
+  o.num("upward_crossings", total_up_).num("downward_crossings", total_down_);
+  o.num("max_up_per_step", max_up_).num("max_pairs_per_grain", max_pairs_per_grain_);
+  o.num("window_steps", p_.window);
+  out.obj("erosion", o);
+}
+
+std::string ErosionObserver::progress(const Model& m, const State& s) const {
+  char b[120];
+  std::snprintf(b, sizeof b, "%d of %d grains above the erosion plane", above_now_, n_grains_);
+  return b;
+}
+
+void ErosionObserver::write_csv(const std::string& path) const {
+  std::ostringstream f;
+  f << "# t (s), step, N above the erosion plane, anchoring and erosion planes (m), upward and downward crossings "
+       "per step, contacts among the grains above per grain above, fraction of them in contact (moving averages "
+       "over "
+    << p_.window << " steps), phase (0 erosion only, 1 erosion and sedimentation, 2 depleted)\n";
+  f << "t,step,above,anchor_plane,erosion_plane,up_per_step,down_per_step,pairs_per_grain,touching_fraction,phase\n";
+  f.precision(9);
+  for (const ErosionRow& r : rows_) {
+    const int phase = t_depleted_ >= 0 && r.t >= t_depleted_ ? 2 : t_first_down_ >= 0 && r.t >= t_first_down_ ? 1 : 0;
+    f << r.t << ',' << r.step << ',' << r.above << ',' << r.anchor << ',' << r.erosion << ',' << r.up << ',' << r.down
+      << ',' << r.pairs_per_grain << ',' << r.touching_fraction << ',' << phase << '\n';
+  }
+  write_file(path, f.str());
+}
+
+}  // namespace rt

@@ -64,7 +64,23 @@ RelaxedBed relax_bed(Scenario& sc, const State& s0, const std::vector<int>& plac
   }
   const std::string cache = opt.cache_dir.empty() ? default_cache_dir() : opt.cache_dir;
   make_dirs(cache + "/beds");
-  out.cache = cache + "/beds/" + bed_key(m, s0, placed) + ".ckpt";
+  std::string key = bed_key(m, s0, placed);
+  // Stages that cut the bed make different beds from the same pour: their
+  // cut heights and criteria join the key (beds without a cut keep theirs).
+  bool trims = false;
+  for (const Stage& st : sc.stages) trims = trims || st.trim;
+  if (trims) {
+    uint64_t h = kFnvOffset;
+    for (const Stage& st : sc.stages) {
+      const double v[] = {double(st.trim), st.trim_above, st.duration, st.until_rms_speed, st.until_max_speed,
+                          st.check_every, st.quench_every, double(st.minimize)};
+      h = fnv1a(v, sizeof v, h);
+    }
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "-c%016llx", static_cast<unsigned long long>(h));
+    key += buf;
+  }
+  out.cache = cache + "/beds/" + key + ".ckpt";
   if (std::ifstream(out.cache).good()) {
     out.state = load_checkpoint(out.cache, m);
     out.from_cache = true;

@@ -1,6 +1,7 @@
 // The built-in scene kinds: a new kind is a folder under src/scenes and a line here.
 #include "regolith_twin/scenes/registry.hpp"
 
+#include "regolith_twin/scenes/impact/impact_scene.hpp"
 #include "regolith_twin/scenes/landing/landing_scene.hpp"
 #include "regolith_twin/scenes/plume/plume_scene.hpp"
 #include "regolith_twin/scenes/sampler/sampler_scene.hpp"
@@ -12,6 +13,7 @@ std::vector<std::shared_ptr<const SceneKind>> builtin_scene_kinds() {
       landing_kind(),  // MASCOT landing: `landing:` (docs/scenes.md A)
       sampler_kind(),  // Hayabusa2 sampler shot: `sampler:` (docs/scenes.md B)
       plume_kind(),    // plume erosion in a periodic box: `plume:` (docs/scenes.md D)
+      impact_kind(),   // bucket impact of a rigid sphere: `impact:` (docs/scenes.md C.1)
   };
 }
 

@@ -211,6 +211,20 @@ int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vec
   return n - kept;
 }
 
+void hold_grain(Model& m, State& s, int i) {
+  m.grain_fixed[i] = 1;
+  m.grain_inv_mass[i] = 0;
+  m.grain_inv_inertia[i] = 0;
+  s.vel[i].setZero();
+  s.omega[i].setZero();
+}
+
+void free_grain(Model& m, int i, double inv_mass, double inv_inertia) {
+  m.grain_fixed[i] = 0;
+  m.grain_inv_mass[i] = inv_mass;
+  m.grain_inv_inertia[i] = inv_inertia;
+}
+
 int add_grain(Model& m, State& s, double radius, int material, const Vec3& pos, const Vec3& vel, const Vec3& omega) {
   if (!(radius > 0)) throw InputError("add_grain: radius must be > 0 m");
   if (material < 0 || material >= m.n_materials()) throw InputError("add_grain: unknown material index");

@@ -79,16 +79,10 @@ bool ActiveZone::update(Model& m, State& s, const Vec3& c, bool first) {
     const bool inside = std::hypot(s.pos[i].x() - c.x(), s.pos[i].y() - c.y()) < radius_;
     if (inside) {
       woken_[i] = 1;
-      m.grain_fixed[i] = 0;
-      m.grain_inv_mass[i] = inv_mass_[i];
-      m.grain_inv_inertia[i] = inv_inertia_[i];
+      free_grain(m, i, inv_mass_[i], inv_inertia_[i]);
       changed = changed || !first;
     } else if (first) {
-      m.grain_fixed[i] = 1;
-      m.grain_inv_mass[i] = 0;
-      m.grain_inv_inertia[i] = 0;
-      s.vel[i].setZero();
-      s.omega[i].setZero();
+      hold_grain(m, s, i);
       changed = true;
     }
   }

@@ -62,6 +62,14 @@ void add_free_flight_summary(JsonObject& j, const RunReport& rep) {
   j.obj("free_flight", o);
 }
 
+void restart_at_zero(State& s) {
+  s.rebuild_requested = true;
+  s.forces_valid = false;
+  s.time = 0;
+  s.step = 0;
+  s.ticks = 0;
+}
+
 void add_sleep_summary(JsonObject& j, const RunReport& rep) {
   if (!rep.sleep) return;
   JsonObject sl;

@@ -30,6 +30,10 @@ struct SceneOptions {
 
 class JsonObject;
 
+// A prepared scene's start state: time, step and ticks from zero, the lists
+// rebuilt and the forces recomputed at the first step.
+void restart_at_zero(State& s);
+
 // One run of a prepared scene: its observers, and its outputs written from them.
 // The run's sleep figures (docs/model.md §16) as j["sleep"], when sleeping was on.
 void add_sleep_summary(JsonObject& j, const RunReport& rep);

@@ -275,11 +275,7 @@ std::unique_ptr<Scene> ImpactKind::prepare(const YAML::Node& doc, const std::str
   b.q = bm.ref_rot.normalized();
   b.pos = Vec3(0, 0, touch + sp.gap + is->radius);
   set_body_velocity(bm, b, Vec3(0, 0, -v0), Vec3::Zero());
-  s.rebuild_requested = true;
-  s.forces_valid = false;
-  s.time = 0;
-  s.step = 0;
-  s.ticks = 0;
+  restart_at_zero(s);
   if (!opt.quiet)
     std::fprintf(stderr,
                  "[impact] bed: %d grains of %.3g mm, surface %.4g m, bulk %.0f kg/m^3 (packing %.3f); sphere %.3g kg, "

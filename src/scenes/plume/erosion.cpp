@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/core/model.hpp"
 #include "regolith_twin/run/series.hpp"
 
@@ -34,17 +35,11 @@ void ErosionObserver::hold(Model& m, State& s, bool first) {
     const bool below = s.pos[i].z() <= a;
     if (below && !held_[i]) {
       held_[i] = 1;
-      m.grain_fixed[i] = 1;
-      m.grain_inv_mass[i] = 0;
-      m.grain_inv_inertia[i] = 0;
-      s.vel[i].setZero();
-      s.omega[i].setZero();
+      hold_grain(m, s, i);
       changed = true;
     } else if (!below && held_[i]) {
       held_[i] = 0;
-      m.grain_fixed[i] = 0;
-      m.grain_inv_mass[i] = inv_mass_[i];
-      m.grain_inv_inertia[i] = inv_inertia_[i];
+      free_grain(m, i, inv_mass_[i], inv_inertia_[i]);
       changed = true;
     }
   }
@@ -205,9 +200,7 @@ void ErosionObserver::finish(Model& m, State& s) {
   if (p_.hold_below_anchor) {  // the model's masses back as they were
     for (int i = 0; i < m.n_grains && i < int(held_.size()); ++i)
       if (held_[i]) {
-        m.grain_fixed[i] = 0;
-        m.grain_inv_mass[i] = inv_mass_[i];
-        m.grain_inv_inertia[i] = inv_inertia_[i];
+        free_grain(m, i, inv_mass_[i], inv_inertia_[i]);
         held_[i] = 0;
       }
     s.rebuild_requested = true;

@@ -235,11 +235,7 @@ std::unique_ptr<Scene> PlumeKind::prepare(const YAML::Node& doc, const std::stri
     ps->splash_grain = add_grain(m, s, 0.5 * d, m.grain_material[0], p0, v0, Vec3::Zero());
   }
   finalize_model(m);
-  s.rebuild_requested = true;
-  s.forces_valid = false;
-  s.time = 0;
-  s.step = 0;
-  s.ticks = 0;
+  restart_at_zero(s);
   if (!opt.quiet)
     std::fprintf(stderr,
                  "[plume] bed: %d grains, top %.2f d, solid fraction %.3f; anchoring plane %.2f d, erosion plane "

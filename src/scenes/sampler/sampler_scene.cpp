@@ -316,10 +316,7 @@ std::unique_ptr<Scene> SamplerKind::prepare(const YAML::Node& doc, const std::st
   const Vec3 p0 = ss->impact - ss->direction * (lift / std::cos(tilt));
   ss->projectile = add_grain(m, s, sp.radius, proj_mat, p0, ss->direction * sp.speed, Vec3::Zero());
   finalize_model(m);
-  s.forces_valid = false;
-  s.time = 0;  // shot time counts from firing
-  s.step = 0;
-  s.ticks = 0;
+  restart_at_zero(s);  // shot time counts from firing
   if (!opt.quiet)
     std::fprintf(stderr,
                  "[sampler] bed: %d grains, packing %.3f, bulk %.0f kg/m^3, rest RMS %.3g m/s; horn bottom at "

@@ -25,7 +25,7 @@ for mat, tag in (("glass_beads", "gb"), ("glass_beads_b", "gbb")):
         BEDS["%s_%d" % (tag, h)] = ["materials.beads.preset=%s" % mat, "stages.1.trim_above=%g" % (h / 100 - 0.005)]
 BEDS["gb_10_5mm"] = ["materials.beads.preset=glass_beads", "grains.0.radius=0.0025", "grains.0.fill.count=100000",
                      "stages.1.trim_above=0.0975"]
-DEFAULT = [b for b in BEDS if not b.endswith("5mm")]
+DEFAULT = ["gb_10", "gbb_10", "gb_8", "gb_12", "gbb_8", "gbb_12"]
 
 
 def run_one(bin_dir, out, docs, bed, v, threads):

@@ -1,0 +1,110 @@
+// The inclined-plane scene kind (`incline:` block, docs/scenes.md C.2): a
+// bed settled in a box periodic in x and y on a rough base of glued grains;
+// gravity is then tilted by theta about the y axis (flow along +x).
+//   mode onset:  theta raised from `start_deg` in `step_deg` steps, each held
+//                `hold` s; the onset angle is the first at which the bed is
+//                still flowing (mean v_x of the free grains above
+//                `flow_speed` sqrt(g d)) at the end of its hold;
+//   mode steady: theta fixed; over the last `average` s of the run, the
+//                velocity and packing profiles in horizontal layers, the
+//                Bagnold fit v_x(z) = A [1 - (1 - z/h)^(3/2)] and the inertial
+//                number it implies, I = 3 d A / (2 h^(3/2) sqrt(Phi g cos theta)).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "regolith_twin/run/scene.hpp"
+
+namespace rt {
+
+struct InclineSpec {
+  bool onset = false;          // mode: onset (true) or steady
+  double angle_deg = 25;       // steady: the tilt
+  double start_deg = 15, step_deg = 1, max_deg = 45, hold = 1.0;  // onset
+  double flow_speed = 0.01;    // onset: flowing above this many sqrt(g d)
+  double duration = 4.0;       // steady: s
+  double average = 1.0;        // steady: the last s averaged
+  double layer = 0.01;         // layer thickness of the profiles, m
+  double sample_every = 0.01;  // s between rows of series.csv
+};
+
+// Velocity and packing profiles (layers from the base's top) and the Bagnold fit.
+struct Profile {
+  std::vector<double> z, vx, packing;  // layer centres above the base (m), mean v_x (m/s), solid fraction
+  double height = 0;                   // flowing depth h above the base, m
+  double packing_mean = 0;             // Phi over the layers below h - layer
+  double bagnold_a = 0;                // A of the fit, m/s
+  double inertial_number = 0;          // I from A, h, Phi, theta
+  double fit_rms = 0;                  // m/s
+};
+
+// Least-squares A of v(z) = A [1 - (1 - z/h)^(3/2)] over layers with z < h.
+double bagnold_amplitude(const std::vector<double>& z, const std::vector<double>& v, double h, double* rms);
+// I = 3 d A / (2 h^(3/2) sqrt(Phi g cos theta)).
+double bagnold_inertial_number(double a, double d, double h, double phi, double g, double theta);
+
+class InclineObserver : public Observer {
+ public:
+  InclineObserver(const InclineSpec& sp, double base_top, double bed_top, double diameter, double area,
+                  double g)
+      : sp_(sp), base_(base_top), top_(bed_top), d_(diameter), area_(area), g_(g) {}
+  void prepare(Model& m, State& s) override;
+  bool after_step(Model& m, State& s) override;
+  void finish(Model& m, State& s) override;
+  void columns(std::vector<std::string>& out) const override;
+  void row(const Model& m, const State& s, std::vector<double>& out) const override;
+  void summary(JsonObject& out) const override;
+  std::string progress(const Model& m, const State& s) const override;
+  void write_csv(const std::string& dir) const;
+
+  double theta_deg() const { return theta_deg_; }
+  double onset_deg() const { return onset_deg_; }  // < 0: none up to max_deg
+  const Profile& profile() const { return prof_; }
+  double mean_vx(const Model& m, const State& s) const;
+
+ private:
+  void tilt(Model& m, State& s, double deg);
+  InclineSpec sp_;
+  double base_, top_, d_, area_, g_;
+  double theta_deg_ = 0, onset_deg_ = -1, hold_from_ = 0;
+  std::vector<std::pair<double, double>> holds_;  // (theta, mean v_x at the end of its hold)
+  std::vector<double> sum_vx_, sum_vol_;
+  std::vector<long> count_;
+  long samples_ = 0;
+  Profile prof_;
+};
+
+class InclineScene : public Scene {
+ public:
+  std::string kind() const override { return "incline"; }
+  double bed_top() const override { return top; }
+  std::unique_ptr<SceneRun> begin(Run& run) const override;
+
+  std::string file;
+  InclineSpec spec;
+  double base_top = 0, top = 0, diameter = 0, area = 0, packing = 0;
+  int grains = 0, base_grains = 0;
+  std::string bed_cache;
+};
+
+class InclineRun : public SceneRun {
+ public:
+  InclineRun(const InclineScene& scene, const Model& m);
+  std::vector<Observer*> observers() override { return {&obs_}; }
+  void write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
+                     int threads) const override;
+  void write_files(const std::string& dir, const Model& m, const State& s, const RunReport& rep) const override;
+  std::vector<std::pair<std::string, std::string>> files() const override;
+  std::string result_line(const Model& m, const State& s, const RunReport& rep) const override;
+  const InclineObserver& observer() const { return obs_; }
+
+ private:
+  const InclineScene& scene_;
+  InclineObserver obs_;
+};
+
+std::shared_ptr<const SceneKind> incline_kind();
+
+}  // namespace rt

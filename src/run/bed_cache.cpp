@@ -4,12 +4,58 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 
 #include "regolith_twin/core/hash.hpp"
+#include "regolith_twin/run/series.hpp"
 #include "regolith_twin/scene/checkpoint.hpp"
 #include "regolith_twin/scenes/scenario/scenario_scene.hpp"
 
 namespace rt {
+namespace {
+
+// A cut (trim stage) removes grains: the model of the relaxed bed differs
+// from the scenario's. Its grains and groups are kept beside the cached
+// checkpoint ("<key>.grains") and put back into the scenario's model.
+void save_grains(const std::string& path, const Scenario& sc) {
+  std::ostringstream f;
+  f.precision(17);
+  const Model& m = sc.model;
+  f << m.n_grains << ' ' << sc.groups.size() << '\n';
+  for (int i = 0; i < m.n_grains; ++i)
+    f << m.grain_radius[i] << ' ' << m.grain_material[i] << ' ' << int(m.grain_fixed[i]) << '\n';
+  for (const GrainGroup& g : sc.groups) f << g.name << ' ' << g.first << ' ' << g.count << '\n';
+  write_file(path, f.str());
+}
+
+void load_grains(const std::string& path, Scenario& sc) {
+  std::ifstream f(path);
+  long n = -1, ng = -1;
+  if (!(f >> n >> ng) || n < 0 || ng < 0 || n > 100000000 || ng > 100000)
+    throw InputError(path + ": not a usable grain list of a cut bed");
+  Model& m = sc.model;
+  std::vector<double> r(n);
+  std::vector<int> mat(n);
+  std::vector<uint8_t> fixed(n);
+  for (long i = 0; i < n; ++i) {
+    int fx = 0;
+    if (!(f >> r[i] >> mat[i] >> fx) || !(r[i] > 0) || mat[i] < 0 || mat[i] >= m.n_materials())
+      throw InputError(path + ": not a usable grain list of a cut bed (grain " + std::to_string(i) + ")");
+    fixed[i] = fx != 0;
+  }
+  std::vector<GrainGroup> groups(ng);
+  for (GrainGroup& g : groups)
+    if (!(f >> g.name >> g.first >> g.count) || g.first < 0 || g.count < 0 || g.first + g.count > n)
+      throw InputError(path + ": not a usable grain list of a cut bed (groups)");
+  m.grain_radius = std::move(r);
+  m.grain_material = std::move(mat);
+  m.grain_fixed = std::move(fixed);
+  m.n_grains = int(n);
+  finalize_model(m);
+  sc.groups = std::move(groups);
+}
+
+}  // namespace
 
 std::string bed_key(const Model& m, const State& s, const std::vector<int>& placed) {
   uint64_t h = kFnvOffset;
@@ -81,7 +127,9 @@ RelaxedBed relax_bed(Scenario& sc, const State& s0, const std::vector<int>& plac
     key += buf;
   }
   out.cache = cache + "/beds/" + key + ".ckpt";
-  if (std::ifstream(out.cache).good()) {
+  const std::string grains = cache + "/beds/" + key + ".grains";
+  if (std::ifstream(out.cache).good() && (!trims || std::ifstream(grains).good())) {
+    if (trims) load_grains(grains, sc);
     out.state = load_checkpoint(out.cache, m);
     out.from_cache = true;
     if (!opt.quiet) std::fprintf(stderr, "[%s] relaxed bed from the cache: %s\n", label.c_str(), out.cache.c_str());
@@ -108,6 +156,15 @@ RelaxedBed relax_bed(Scenario& sc, const State& s0, const std::vector<int>& plac
   if (!opt.quiet)
     std::fprintf(stderr, "[%s] bed relaxed in %.4g s simulated (%s)\n", label.c_str(), rr.sim_time,
                  rr.stages.empty() ? "" : rr.stages.back().reason.c_str());
+  if (relax.model.n_grains != sc.model.n_grains) {  // a cut: the bed's grains replace the scenario's
+    sc.model.grain_radius = relax.model.grain_radius;
+    sc.model.grain_material = relax.model.grain_material;
+    sc.model.grain_fixed = relax.model.grain_fixed;
+    sc.model.n_grains = relax.model.n_grains;
+    finalize_model(sc.model);
+    sc.groups = relax.groups;
+  }
+  if (trims) save_grains(grains, sc);
   save_checkpoint(out.cache, sc.model, out.state);
   return out;
 }

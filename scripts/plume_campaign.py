@@ -29,7 +29,10 @@ def both(key, value):
 RUNS = {
     "base": ([], SEEDS, "calibrated case: depletion at about 0.15 s"),
     "upward": (["plume.plane_motion=upward"], SEEDS, "planes moved by upward crossings only (decision check)"),
-    "collisionless": (["plume.collisionless=true"], SEEDS, "no grain-grain contacts: collisions' effect on the rate"),
+    # Free grains strike the held (rigid) bed at up to the gas speed: overlaps reach 0.26 of a radius at
+    # k_n = 8000 N/m, beyond the default guard of 0.25 (docs/model.md §13).
+    "collisionless": (["plume.collisionless=true", "guards.max_overlap_ratio=0.5"], SEEDS,
+                      "no contacts among the free grains (the held bed still supports them)"),
     "nondissipative": (both("eps_n", 1) + both("mu_s", 0), SEEDS, "eps = 1, mu = 0"),
     "pen2": (["plume.penetration_depth=2"], SEEDS, "penetration depth 2 d"),
     "pen6": (["plume.penetration_depth=6"], SEEDS, "penetration depth 6 d"),

@@ -163,6 +163,7 @@ void row_partners(const Model& m, const State& s, const Grid& g, int i, std::vec
       const int j = s.cell_items[q];
       if (j <= i) continue;
       if (m.grain_fixed[i] && m.grain_fixed[j]) continue;  // glued pairs never interact
+      if (!m.mobile_contacts && !m.grain_fixed[i] && !m.grain_fixed[j]) continue;  // collisionless
       const double cut = ri + m.grain_radius[j] + skin;
       if ((s.pos[j] - xi).squaredNorm() < cut * cut) out.push_back(j);
     }
@@ -231,6 +232,7 @@ void row_partners_periodic(const Model& m, const State& s, const Grid& g, int i,
       const int j = s.cell_items[q];
       if (j <= i) continue;
       if (m.grain_fixed[i] && m.grain_fixed[j]) continue;  // glued pairs never interact
+      if (!m.mobile_contacts && !m.grain_fixed[i] && !m.grain_fixed[j]) continue;  // collisionless
       Vec3 d = s.pos[j] - xi;
       int sx = 0, sy = 0;
       if (p.x) {

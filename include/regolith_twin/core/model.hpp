@@ -211,6 +211,10 @@ struct Model {
   // Grain–grain contacts on (the default). Off: the pair list stays empty and
   // grains touch only walls and bodies (a collisionless study, docs/model.md §11).
   bool grain_contacts = true;
+  // Contacts between two free (not glued) grains on (the default). Off: free
+  // grains touch glued grains, walls and bodies only, never each other (the
+  // collisionless plume, docs/scenes.md D).
+  bool mobile_contacts = true;
 
   // --- integration ---
   double dt = 1e-5;                    // s

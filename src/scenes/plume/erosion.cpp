@@ -77,7 +77,7 @@ void ErosionObserver::start(const Model& m, const State& s) {
 void ErosionObserver::count(const Model& m, const State& s, int& pairs, int& touching) const {
   pairs = 0;
   touching = 0;
-  if (above_now_ == 0 || !m.grain_contacts || s.pairs.row_start.size() != size_t(m.n_grains) + 1) return;
+  if (above_now_ == 0 || !m.grain_contacts || !m.mobile_contacts || s.pairs.row_start.size() != size_t(m.n_grains) + 1) return;
   std::vector<uint8_t> touched;  // only when some grain is above: small
   touched.assign(m.n_grains, 0);
   const PairList& pl = s.pairs;

@@ -224,7 +224,7 @@ std::unique_ptr<Scene> PlumeKind::prepare(const YAML::Node& doc, const std::stri
     ps->gas_at_top = g.velocity(h);
     ps->shear_at_top = ps->gas_at_top != 0 ? std::abs(g.gradient(h)) * d / std::abs(ps->gas_at_top) : 0;
   }
-  if (sp.collisionless) m.grain_contacts = false;
+  if (sp.collisionless) m.mobile_contacts = false;
 
   // 4. The splash grain: one more grain of the bed's size and material.
   if (sp.splash) {

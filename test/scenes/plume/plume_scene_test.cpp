@@ -130,7 +130,20 @@ TEST(GrainContacts, SwitchedOffGrainsPassThroughEachOther) {
   EXPECT_EQ(f.s.pairs.size(), 0);
   EXPECT_EQ(f.s.vel[0], Vec3::Zero());
   EXPECT_EQ(f.s.vel[1], Vec3::Zero());
-  f.m.grain_contacts = true;  // the same overlap pushes them apart
+  f.m.grain_contacts = true;
+  f.m.mobile_contacts = false;  // free grains pass through each other ...
+  f.s.rebuild_requested = true;
+  for (int k = 0; k < 10; ++k) rt::step(f.m, f.s);
+  EXPECT_EQ(f.s.pairs.size(), 0);
+  EXPECT_EQ(f.s.vel[1], Vec3::Zero());
+  rt::hold_grain(f.m, f.s, 0);  // ... but touch a glued one
+  f.s.rebuild_requested = true;
+  rt::step(f.m, f.s);
+  EXPECT_GT(f.s.vel[1].x(), 0);
+  EXPECT_EQ(f.s.vel[0], Vec3::Zero());
+  rt::free_grain(f.m, 0, f.m.grain_inv_mass[1], f.m.grain_inv_inertia[1]);
+  f.s.vel[1] = Vec3::Zero();
+  f.m.mobile_contacts = true;  // the same overlap pushes both apart
   f.s.rebuild_requested = true;
   rt::step(f.m, f.s);
   EXPECT_LT(f.s.vel[0].x(), 0);

@@ -3,7 +3,8 @@
 // an anchoring plane that follows the eroding surface; the bed is settled
 // with the gas off and cached, the planes placed from its top, and each run
 // measures the erosion (erosion.hpp). Variants: collisionless (no
-// grain–grain contacts, the bed below the anchoring plane held), and the
+// contacts among the free grains; the bed below the anchoring plane held and
+// touching them), and the
 // single-grain splash (one grain shot into the bed, no gas).
 #pragma once
 

@@ -271,9 +271,7 @@ void build_pairs(const Model& m, State& s, const Grid& g) {
       const int ib = int(long(n) * b / P), ie = int(long(n) * (b + 1) / P);
       for (int i = ib; i < ie; ++i) {
         const size_t before = out.size();
-        if (!m.grain_contacts)
-          ;  // an empty row
-        else if (periodic)
+        if (periodic)
           row_partners_periodic(m, s, g, i, out);
         else
           row_partners(m, s, g, i, out);

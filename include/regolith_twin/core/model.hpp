@@ -208,9 +208,6 @@ struct Model {
   // Per-grain force fields added after the contacts (field.hpp), in this
   // order. Shared, immutable: copies of the Model share them. Empty: none.
   std::vector<std::shared_ptr<const Field>> fields;
-  // Grain–grain contacts on (the default). Off: the pair list stays empty and
-  // grains touch only walls and bodies (a collisionless study, docs/model.md §11).
-  bool grain_contacts = true;
   // Contacts between two free (not glued) grains on (the default). Off: free
   // grains touch glued grains, walls and bodies only, never each other (the
   // collisionless plume, docs/scenes.md D).

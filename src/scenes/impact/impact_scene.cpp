@@ -48,10 +48,8 @@ ImpactSpec parse_impact(const YAML::Node& n, const std::string& src) {
 
 void ImpactTracker::start(const Model& m, const State& s) {
   mass_ = m.bodies[body_].mass;
-  v_prev_ = s.bodies[body_].vel.z();
-  t_prev_ = s.time;
   min_bottom_ = s.bodies[body_].pos.z() - radius_;
-  rows_.push_back({s.time, min_bottom_ - surface_, v_prev_, -g_});
+  rows_.push_back({s.time, min_bottom_ - surface_, s.bodies[body_].vel.z(), -g_});
 }
 
 bool ImpactTracker::after_step(Model& m, State& s) {
@@ -83,8 +81,6 @@ bool ImpactTracker::after_step(Model& m, State& s) {
     }
   }
   if (s.time - rows_.back().t >= 1e-4 - 1e-12) rows_.push_back({s.time, bottom - surface_, v, a});
-  v_prev_ = v;
-  t_prev_ = s.time;
   return t_rest_from_ >= 0 && s.time - t_rest_from_ >= spec_.rest_time;  // at rest: the run ends
 }
 

@@ -63,8 +63,11 @@ void ErosionObserver::start(const Model& m, const State& s) {
   ring_pairs_.assign(w, 0);
   ring_touch_.assign(w, 0);
   ring_n_.assign(w, 0);
-  n_series_.assign(1, above_now_);
-  t_series_.assign(1, s.time);
+  touched_.assign(m.n_grains, 0);
+  t0_ = s.time;
+  fit_sx_ = fit_sy_ = fit_sxx_ = fit_sxy_ = 0;
+  fit_n_ = 0;
+  add_fit_point(s.time, above_now_);
   ErosionRow r;
   r.t = s.time;
   r.step = s.step;
@@ -72,14 +75,23 @@ void ErosionObserver::start(const Model& m, const State& s) {
   r.anchor = s.field_values[p_.anchor_slot];
   r.erosion = e;
   rows_.assign(1, r);
+  last_ = r;
+}
+
+void ErosionObserver::add_fit_point(double t, int n) {
+  const double x = t - t0_, y = n;
+  fit_sx_ += x;
+  fit_sy_ += y;
+  fit_sxx_ += x * x;
+  fit_sxy_ += x * y;
+  ++fit_n_;
 }
 
 void ErosionObserver::count(const Model& m, const State& s, int& pairs, int& touching) const {
   pairs = 0;
   touching = 0;
-  if (above_now_ == 0 || !m.grain_contacts || !m.mobile_contacts || s.pairs.row_start.size() != size_t(m.n_grains) + 1) return;
-  std::vector<uint8_t> touched;  // only when some grain is above: small
-  touched.assign(m.n_grains, 0);
+  if (above_now_ == 0 || !m.mobile_contacts || s.pairs.row_start.size() != size_t(m.n_grains) + 1) return;
+  std::vector<uint8_t>& touched = touched_;
   const PairList& pl = s.pairs;
   for (int i = 0; i < m.n_grains; ++i) {
     if (!is_above_[i]) continue;
@@ -90,7 +102,10 @@ void ErosionObserver::count(const Model& m, const State& s, int& pairs, int& tou
       touched[i] = touched[j] = 1;
     }
   }
-  for (int i = 0; i < m.n_grains; ++i) touching += touched[i];
+  for (int i = 0; i < m.n_grains; ++i) {
+    touching += touched[i];
+    touched[i] = 0;
+  }
 }
 
 bool ErosionObserver::after_step(Model& m, State& s) {
@@ -134,8 +149,7 @@ bool ErosionObserver::after_step(Model& m, State& s) {
   ring_n_[k] = above_now_;
   ++ring_pos_;
   ++steps_;
-  n_series_.push_back(above_now_);
-  t_series_.push_back(s.time);
+  if (t_depleted_ < 0 || s.time <= t_depleted_) add_fit_point(s.time, above_now_);  // up to depletion
   const long w = std::min<long>(ring_pos_, long(ring_up_.size()));
   ErosionRow r;
   r.t = s.time;
@@ -149,6 +163,7 @@ bool ErosionObserver::after_step(Model& m, State& s) {
   r.touching_fraction = sum_n_ > 0 ? double(sum_touch_) / sum_n_ : 0;
   max_pairs_per_grain_ = std::max(max_pairs_per_grain_, r.pairs_per_grain);
   max_up_ = std::max(max_up_, r.up);
+  last_ = r;
   if (steps_ % std::max(1, p_.sample_every) == 0) rows_.push_back(r);
   return false;
 }
@@ -160,40 +175,20 @@ void ErosionObserver::columns(std::vector<std::string>& out) const {
 }
 
 void ErosionObserver::row(const Model& m, const State& s, std::vector<double>& out) const {
-  const ErosionRow& r = rows_.back();
-  const bool now = r.step == s.step;
+  const ErosionRow& r = last_;
   out.push_back(above_now_);
   out.push_back(s.field_values.size() > size_t(p_.anchor_slot) ? s.field_values[p_.anchor_slot] : p_.anchor);
   out.push_back(s.field_values.size() > size_t(p_.erosion_slot) ? s.field_values[p_.erosion_slot] : p_.erosion);
-  out.push_back(now ? r.up : 0);
-  out.push_back(now ? r.down : 0);
-  out.push_back(now ? r.pairs_per_grain : 0);
-  out.push_back(now ? r.touching_fraction : 0);
+  out.push_back(r.up);
+  out.push_back(r.down);
+  out.push_back(r.pairs_per_grain);
+  out.push_back(r.touching_fraction);
 }
 
 void ErosionObserver::finish(Model& m, State& s) {
-  if (!rows_.empty() && rows_.back().step != s.step && steps_ > 0) {
-    // the last step's row, for the file's end
-    ErosionRow r = rows_.back();
-    r.t = s.time;
-    r.step = s.step;
-    r.above = above_now_;
-    r.anchor = s.field_values[p_.anchor_slot];
-    r.erosion = s.field_values[p_.erosion_slot];
-    rows_.push_back(r);
-  }
+  if (!rows_.empty() && rows_.back().step != last_.step) rows_.push_back(last_);  // the last step's row
   // Erosion rate: one least-squares line through N(t) over the non-depleted phase.
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  long n = 0;
-  for (size_t k = 0; k < n_series_.size(); ++k) {
-    if (t_depleted_ >= 0 && t_series_[k] > t_depleted_) break;
-    const double x = t_series_[k] - t_series_[0], y = n_series_[k];
-    sx += x;
-    sy += y;
-    sxx += x * x;
-    sxy += x * y;
-    ++n;
-  }
+  const double n = double(fit_n_), sx = fit_sx_, sy = fit_sy_, sxx = fit_sxx_, sxy = fit_sxy_;
   const double den = n * sxx - sx * sx;
   rate_ = n > 1 && den > 0 ? (n * sxy - sx * sy) / den : 0;
   rate_intercept_ = n > 0 ? (sy - rate_ * sx) / n : 0;

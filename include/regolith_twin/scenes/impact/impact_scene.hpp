@@ -56,7 +56,7 @@ class ImpactTracker : public Observer {
   double radius_, surface_, g_;
   ImpactSpec spec_;
   double mass_ = 1;
-  double v_prev_ = 0, t_prev_ = 0, min_bottom_ = 1e300;
+  double min_bottom_ = 1e300;
   double t_contact_ = -1, t_1cm_ = -1, t_1mm_ = -1, t_rest_from_ = -1, max_up_ = 0;
   double fit_t0_ = 0, fit_v0_ = 0;
   std::vector<double> fit_v_, fit_a_;

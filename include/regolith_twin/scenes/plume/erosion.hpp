@@ -86,8 +86,12 @@ class ErosionObserver : public Observer {
   ErosionPlanes p_;
   std::vector<uint8_t> is_above_, held_;
   std::vector<double> inv_mass_, inv_inertia_;
-  std::vector<int> n_series_;        // N after every step (for the fit)
-  std::vector<double> t_series_;
+  mutable std::vector<uint8_t> touched_;  // count()'s scratch, sized once
+  // Least-squares sums of N(t) up to depletion (t from the start).
+  double t0_ = 0, fit_sx_ = 0, fit_sy_ = 0, fit_sxx_ = 0, fit_sxy_ = 0;
+  long fit_n_ = 0;
+  void add_fit_point(double t, int n);
+  ErosionRow last_;                  // this step's row (series.csv reads it)
   // Ring buffers of the last `window` steps.
   std::vector<int> ring_up_, ring_down_, ring_pairs_, ring_touch_, ring_n_;
   long ring_pos_ = 0;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 
 #include "regolith_twin/core/body.hpp"
@@ -17,6 +18,7 @@ namespace rt {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 class ImpactKind : public SceneKind {
  public:
@@ -256,13 +258,18 @@ std::unique_ptr<Scene> ImpactKind::prepare(const YAML::Node& doc, const std::str
   is->bulk_density = mass / (area * top);
   is->packing = vol / (area * top);
 
-  // 3. The sphere on the axis, its bottom `gap` above the highest bead top
-  // under it (first touch), moving down so that it reaches that height at
-  // `speed` (gap at most V^2 / 4g).
-  double touch = top;
-  for (int i = 0; i < m.n_grains; ++i)
-    if (std::hypot(s.pos[i].x(), s.pos[i].y()) < is->radius + m.grain_radius[i])
-      touch = std::max(touch, s.pos[i].z() + m.grain_radius[i]);
+  // 3. The sphere on the axis, its bottom `gap` above the height at which it
+  // would first touch a bead (first touch: a bead at a distance rho from the
+  // axis meets the descending sphere when its bottom is at
+  // z_i + sqrt((R + r_i)^2 - rho^2) - R), moving down so that it reaches that
+  // height at `speed` (gap at most V^2 / 4g).
+  double touch = -kInf;
+  for (int i = 0; i < m.n_grains; ++i) {
+    const double reach = is->radius + m.grain_radius[i];
+    const double rho = std::hypot(s.pos[i].x(), s.pos[i].y());
+    if (rho < reach) touch = std::max(touch, s.pos[i].z() + std::sqrt(reach * reach - rho * rho) - is->radius);
+  }
+  if (touch == -kInf) touch = top;
   is->first_touch = touch;
   const double g = m.gravity.norm();
   sp.gap = std::min(sp.gap, 0.25 * sp.speed * sp.speed / g);

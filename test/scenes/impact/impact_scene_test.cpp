@@ -85,11 +85,18 @@ TEST(ImpactScene, ASphereIntoASettledBed) {
   EXPECT_LT(sc.surface, 0.051);
   EXPECT_GT(sc.packing, 0.45);
   EXPECT_LT(sc.packing, 0.66);
-  // Placed on the axis, bottom `gap` above the highest bead under it, reaching it at 0.5 m/s in free fall.
+  // Placed on the axis, bottom `gap` above its first touch of a bead, reaching it at 0.5 m/s in free fall.
   const rt::BodyState& b = sc.start.bodies[sc.body];
   EXPECT_GE(sc.first_touch, sc.surface);
   EXPECT_LT(sc.first_touch, sc.surface + 0.01);
   EXPECT_NEAR(b.pos.z() - sc.radius - sc.first_touch, sc.spec.gap, 1e-12);
+  // First touch: lowered by `gap`, the sphere touches one bead (curvature included) and overlaps none.
+  double clearance = 1e9;
+  for (int i = 0; i < m0.n_grains; ++i) {
+    const rt::Vec3 c(0, 0, sc.first_touch + sc.radius);
+    clearance = std::min(clearance, (sc.start.pos[i] - c).norm() - sc.radius - m0.grain_radius[i]);
+  }
+  EXPECT_NEAR(clearance, 0.0, 1e-12);
   const double v2 = b.vel.squaredNorm() + 2 * 9.81 * sc.spec.gap;
   EXPECT_NEAR(std::sqrt(v2), 0.5, 1e-12);
   // The impact.

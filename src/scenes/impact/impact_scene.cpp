@@ -227,9 +227,12 @@ std::unique_ptr<Scene> ImpactKind::prepare(const YAML::Node& doc, const std::str
     if (w.type == WallType::Cylinder) is->container_radius = w.radius;
   if (!(is->container_radius > 0)) rd.fail("walls", "the impact scene needs the container's cylinder wall");
 
-  // 1. The bed: poured, settled and cut by the stages (cached), the sphere parked far above.
+  // 1. The bed: poured, settled and cut by the stages (cached), the sphere parked far above: it falls
+  // freely meanwhile, so 100 m above the height it falls through in the stages' whole duration.
+  double relax_time = 0;
+  for (const Stage& st : sc.stages) relax_time += st.duration;
   State s = sc.initial;
-  s.bodies[is->body].pos = Vec3(0, 0, 100.0);
+  s.bodies[is->body].pos = Vec3(0, 0, 100.0 + 0.5 * m.gravity.norm() * relax_time * relax_time);
   RelaxedBed bed = relax_bed(sc, s, {is->body}, opt, "impact");
   s = std::move(bed.state);
   is->bed_cache = bed.cache;

@@ -7,7 +7,8 @@
 
 A finished run's summary.json and its N(t) every millisecond are copied to
 DOCS/RUN/ (committed: a campaign resumes on any machine; a run whose copy
-exists is not run again unless PLUME_RERUN=1).
+exists is not run again unless PLUME_RERUN=1); a run that stopped leaves
+DOCS/RUN/failed.txt (its exit and last lines), reported and not retried.
 """
 import csv
 import json
@@ -55,8 +56,11 @@ for e in (0.6, 0.8):
 def run_one(bin_dir, out, docs, name, seed, extra=(), tag=None):
     tag = tag or "%s_s%d" % (name, seed)
     keep = os.path.join(docs, tag)
-    if os.path.exists(os.path.join(keep, "summary.json")) and os.environ.get("PLUME_RERUN") != "1":
-        return json.load(open(os.path.join(keep, "summary.json")))
+    if os.environ.get("PLUME_RERUN") != "1":
+        if os.path.exists(os.path.join(keep, "summary.json")):
+            return json.load(open(os.path.join(keep, "summary.json")))
+        if os.path.exists(os.path.join(keep, "failed.txt")):  # a run that stopped is reported, not retried
+            return None
     overrides = list(RUNS[name][0]) if name in RUNS else []
     overrides += list(extra) + ["seed=%d" % seed]
     d = os.path.join(out, tag)
@@ -68,6 +72,10 @@ def run_one(bin_dir, out, docs, name, seed, extra=(), tag=None):
     if r.returncode != 0:
         sys.stderr.write(r.stdout[-3000:])
         print("%s: FAILED (exit %d; the campaign goes on)" % (tag, r.returncode), flush=True)
+        os.makedirs(keep, exist_ok=True)
+        with open(os.path.join(keep, "failed.txt"), "w") as f:
+            f.write("exit %d after %.0f s; %s\n" % (r.returncode, time.time() - t0, " ".join(overrides)))
+            f.write("\n".join(r.stdout.strip().splitlines()[-3:]) + "\n")
         return None
     wall = time.time() - t0
     os.makedirs(keep, exist_ok=True)

@@ -84,8 +84,14 @@ def report(docs, RUNS):
              "| run | what | seeds | erosion rate (grains/s) | rate per area (1/(s m²)) | depleted at (s) | "
              "up / down crossings | max pairs per grain above | max touching fraction | wall (s) |",
              "|---|---|---|---|---|---|---|---|---|---|"]
+    failed = {}
+    for f in sorted(glob.glob(os.path.join(docs, "*_s*", "failed.txt"))):
+        tag = os.path.basename(os.path.dirname(f))
+        failed.setdefault(tag.rsplit("_s", 1)[0], []).append((tag, open(f).read().strip()))
     for name, (ov, seeds, what) in RUNS.items():
         rs = runs.get(name, [])
+        if name in failed:
+            what += " (%d stopped, below)" % len(failed[name])
         if not rs:
             lines.append("| %s | %s | 0 of %d | not run yet | | | | | | |" % (name, what, len(seeds)))
             continue
@@ -105,6 +111,11 @@ def report(docs, RUNS):
         lines.append("| %s | %s | %d of %d | %s | %s | %s | %.0f / %.0f | %s | %s | %.0f |" % (
             name, what, len(rs), len(seeds), fmt(*rate), fmt(*area), dep_txt, up[0], down[0], fmt(*pairs),
             fmt(*mean_sd(touch)), wall[0]))
+    if failed:
+        lines += ["", "Runs that stopped (the engine's guards; their partial output is not used):", ""]
+        for name in failed:
+            for tag, text in failed[name]:
+                lines.append("- `%s`: %s" % (tag, " ".join(text.split())))
     lines += ["", "Published statements each run can be compared with (Berger et al. 2013):", ""]
     for k, v in PUBLISHED.items():
         lines.append("- `%s`%s: %s" % (k, " (every ε–μ run)" if k == "e" else "", v))

@@ -7,15 +7,16 @@
 Beds: glass_beads or glass_beads_b, cut at 8, 10 or 12 cm (gb_8 ... gbb_12), and
 gb_10_5mm (5 mm beads, 10 cm: the costly one, not in the default list). A
 finished run's summary.json and impact.csv are copied to DOCS/BED_vSPEED/
-(committed: a campaign resumes on any machine; BUCKET_RERUN=1 runs again).
+(committed: a campaign resumes on any machine; BUCKET_RERUN=1 runs again); a
+run that stopped leaves failed.txt there, not retried.
 """
 import json
 import math
 import os
-import shutil
-import subprocess
 import sys
-import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
+import campaign_cli  # noqa: E402
 
 CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "bucket_impact.yaml")
 SPEEDS = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0]
@@ -31,28 +32,17 @@ DEFAULT = ["gb_10", "gbb_10", "gb_8", "gb_12", "gbb_8", "gbb_12"]
 def run_one(bin_dir, out, docs, bed, v, threads):
     tag = "%s_v%.2f" % (bed, v)
     keep = os.path.join(docs, tag)
-    if os.path.exists(os.path.join(keep, "summary.json")) and os.environ.get("BUCKET_RERUN") != "1":
+    if campaign_cli.kept(keep, "BUCKET_RERUN") is not None:
         return
-    d = os.path.join(out, tag)
-    cmd = [os.path.join(bin_dir, "regolith_sim"), CONFIG, "--threads", str(threads), "--out", d, "--quiet",
-           "--set", "impact.speed=%g" % v]
-    for o in BEDS[bed]:
-        cmd += ["--set", o]
-    t0 = time.time()
-    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    if r.returncode != 0:
-        sys.stderr.write(r.stdout[-3000:])
-        print("%s: FAILED (exit %d; the campaign goes on)" % (tag, r.returncode), flush=True)
+    overrides = ["impact.speed=%g" % v] + BEDS[bed]
+    s = campaign_cli.run_and_keep(bin_dir, CONFIG, os.path.join(out, tag), keep, overrides,
+                                  {"bed": bed, "speed": v}, copies=["impact.csv"], threads=threads)
+    if s is None:
         return
-    os.makedirs(keep, exist_ok=True)
-    s = json.load(open(os.path.join(d, "summary.json")))
-    s["campaign"] = {"bed": bed, "speed": v, "wall_seconds": time.time() - t0}
-    with open(os.path.join(keep, "summary.json"), "w") as f:
-        json.dump(s, f, indent=1)
-    shutil.copy(os.path.join(d, "impact.csv"), os.path.join(keep, "impact.csv"))
     res = s["result"]
     print("%s: z_stop %.4g m, %.4g s to 1 cm/s, f0 %.4g N, 1/d1 %.4g 1/m (%.0f s)" % (
-        tag, res["stopping_depth"], res["duration_1cm_s"], res["f0"], res["inv_d1"], time.time() - t0), flush=True)
+        tag, res["stopping_depth"], res["duration_1cm_s"], res["f0"], res["inv_d1"], s["campaign"]["wall_seconds"]),
+        flush=True)
 
 
 def power_fit(xs, ys):
@@ -151,6 +141,7 @@ def report(docs):
         fig.savefig(os.path.join(docs, "bucket.png"), dpi=110)
         lines += ["", "![stopping depth, power law and durations](bucket.png)"]
     plt.close(fig)
+    lines += campaign_cli.failure_lines(docs)
     lines += ["", "| bed | V (m/s) | z_stop (cm) | H (cm) | to 1 cm/s (ms) | to 1 mm/s (ms) | f₀ (N) | 1/d₁ (1/m) | "
               "bounced |", "|---|---|---|---|---|---|---|---|---|"] + detail
     with open(os.path.join(docs, "report.md"), "w") as f:
@@ -159,17 +150,12 @@ def report(docs):
 
 
 def main():
-    if len(sys.argv) < 5:
-        raise SystemExit(__doc__)
-    bin_dir, out, docs, cmd = sys.argv[1:5]
-    os.makedirs(out, exist_ok=True)
-    os.makedirs(docs, exist_ok=True)
+    bin_dir, out, docs, cmd, beds = campaign_cli.command_line(__doc__)
     threads = int(os.environ.get("BUCKET_THREADS", "1"))
     if cmd == "run":
-        beds = sys.argv[5:] or DEFAULT
+        beds = beds or DEFAULT
+        campaign_cli.check_names(beds, BEDS, "bed")
         for b in beds:
-            if b not in BEDS:
-                raise SystemExit("unknown bed '%s' (%s)" % (b, " ".join(BEDS)))
             for v in SPEEDS:
                 run_one(bin_dir, out, docs, b, v, threads)
     elif cmd == "report":

@@ -7,17 +7,18 @@
 Runs: onset_MAT (1-degree steps from rest, MAT = moderate or gravel) and MAT_ANGLE
 (steady flow at ANGLE degrees: profiles over the last second, Bagnold fit, I). A
 finished run's summary.json (and profile.csv) are copied to DOCS/RUN/ (committed:
-a campaign resumes on any machine; INCLINE_RERUN=1 runs them again).
+a campaign resumes on any machine; INCLINE_RERUN=1 runs them again); a run
+that stopped leaves failed.txt there, not retried.
 mu(I) = mu1 + (mu2 - mu1) / (I0 / I + 1) is fitted to the steady runs of a material
 with at least 4 angles (least squares: mu1, mu2 linear for each I0 on a log grid).
 """
 import json
 import math
 import os
-import shutil
-import subprocess
 import sys
-import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
+import campaign_cli  # noqa: E402
 
 CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "incline_moderate.yaml")
 
@@ -38,26 +39,13 @@ for m, angles in STEADY.items():
 
 def run_one(bin_dir, out, docs, name):
     keep = os.path.join(docs, name)
-    if os.path.exists(os.path.join(keep, "summary.json")) and os.environ.get("INCLINE_RERUN") != "1":
+    if campaign_cli.kept(keep, "INCLINE_RERUN") is not None:
         return
-    d = os.path.join(out, name)
-    cmd = [os.path.join(bin_dir, "regolith_sim"), CONFIG, "--threads", "1", "--out", d, "--quiet"]
-    for o in RUNS[name][0]:
-        cmd += ["--set", o]
-    t0 = time.time()
-    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    if r.returncode != 0:
-        sys.stderr.write(r.stdout[-3000:])
-        print("%s: FAILED (exit %d; the campaign goes on)" % (name, r.returncode), flush=True)
-        return
-    os.makedirs(keep, exist_ok=True)
-    s = json.load(open(os.path.join(d, "summary.json")))
-    s["campaign"] = {"run": name, "overrides": RUNS[name][0], "wall_seconds": time.time() - t0}
-    with open(os.path.join(keep, "summary.json"), "w") as f:
-        json.dump(s, f, indent=1)
-    if os.path.exists(os.path.join(d, "profile.csv")):
-        shutil.copy(os.path.join(d, "profile.csv"), os.path.join(keep, "profile.csv"))
-    print("%s: %s (%.0f s)" % (name, json.dumps(s["observers"]["incline"])[:300], time.time() - t0), flush=True)
+    s = campaign_cli.run_and_keep(bin_dir, CONFIG, os.path.join(out, name), keep, RUNS[name][0], {"run": name},
+                                  copies=["profile.csv"])
+    if s is not None:
+        print("%s: %s (%.0f s)" % (name, json.dumps(s["observers"]["incline"])[:300], s["campaign"]["wall_seconds"]),
+              flush=True)
 
 
 def fit_mu_i(points):
@@ -145,6 +133,7 @@ def report(docs):
             ax[2].plot(ii, [mu1 + (mu2 - mu1) * i / (i0 + i) for i in ii], "-", lw=1, label="%s fit" % m)
         elif pts:
             fits.append("| %s | %d | (a fit needs 4 angles) | | | |" % (m, len(pts)))
+    lines += campaign_cli.failure_lines(docs)
     lines += ["", "Fitted mu(I) = mu1 + (mu2 - mu1) / (I0 / I + 1):", "",
               "| material | angles | mu1 | mu2 | I0 | rms |", "|---|---|---|---|---|---|"] + fits
     ax[0].set_xlabel("mean v_x in the layer (m/s); gray: Bagnold fit")
@@ -168,16 +157,10 @@ def report(docs):
 
 
 def main():
-    if len(sys.argv) < 5:
-        raise SystemExit(__doc__)
-    bin_dir, out, docs, cmd = sys.argv[1:5]
-    os.makedirs(out, exist_ok=True)
-    os.makedirs(docs, exist_ok=True)
+    bin_dir, out, docs, cmd, names = campaign_cli.command_line(__doc__)
     if cmd == "run":
-        names = sys.argv[5:] or list(RUNS)
-        for n in names:
-            if n not in RUNS:
-                raise SystemExit("unknown run '%s' (%s)" % (n, " ".join(RUNS)))
+        names = names or list(RUNS)
+        campaign_cli.check_names(names, RUNS)
         for n in names:
             run_one(bin_dir, out, docs, n)
     elif cmd == "report":

@@ -13,9 +13,10 @@ DOCS/RUN/failed.txt (its exit and last lines), reported and not retried.
 import csv
 import json
 import os
-import subprocess
 import sys
-import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
+import campaign_cli  # noqa: E402
 
 CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "plume_erosion.yaml")
 SEEDS = [1, 2, 3]
@@ -56,33 +57,14 @@ for e in (0.6, 0.8):
 def run_one(bin_dir, out, docs, name, seed, extra=(), tag=None):
     tag = tag or "%s_s%d" % (name, seed)
     keep = os.path.join(docs, tag)
-    if os.environ.get("PLUME_RERUN") != "1":
-        if os.path.exists(os.path.join(keep, "summary.json")):
-            return json.load(open(os.path.join(keep, "summary.json")))
-        if os.path.exists(os.path.join(keep, "failed.txt")):  # a run that stopped is reported, not retried
-            return None
-    overrides = list(RUNS[name][0]) if name in RUNS else []
-    overrides += list(extra) + ["seed=%d" % seed]
+    s = campaign_cli.kept(keep, "PLUME_RERUN")
+    if s is not None:
+        return None if s == "failed" else s
+    overrides = (list(RUNS[name][0]) if name in RUNS else []) + list(extra) + ["seed=%d" % seed]
     d = os.path.join(out, tag)
-    cmd = [os.path.join(bin_dir, "regolith_sim"), CONFIG, "--threads", "1", "--out", d, "--quiet"]
-    for o in overrides:
-        cmd += ["--set", o]
-    t0 = time.time()
-    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    if r.returncode != 0:
-        sys.stderr.write(r.stdout[-3000:])
-        print("%s: FAILED (exit %d; the campaign goes on)" % (tag, r.returncode), flush=True)
-        os.makedirs(keep, exist_ok=True)
-        with open(os.path.join(keep, "failed.txt"), "w") as f:
-            f.write("exit %d after %.0f s; %s\n" % (r.returncode, time.time() - t0, " ".join(overrides)))
-            f.write("\n".join(r.stdout.strip().splitlines()[-3:]) + "\n")
+    s = campaign_cli.run_and_keep(bin_dir, CONFIG, d, keep, overrides, {"run": name, "seed": seed})
+    if s is None:
         return None
-    wall = time.time() - t0
-    os.makedirs(keep, exist_ok=True)
-    s = json.load(open(os.path.join(d, "summary.json")))
-    s["campaign"] = {"run": name, "seed": seed, "overrides": overrides, "wall_seconds": wall}
-    with open(os.path.join(keep, "summary.json"), "w") as f:
-        json.dump(s, f, indent=1)
     with open(os.path.join(d, "erosion.csv")) as f, open(os.path.join(keep, "n_of_t.csv"), "w") as g:
         rows = [r for r in csv.reader(x for x in f if not x.startswith("#"))]
         g.write("t,above,erosion_plane,up_per_step,down_per_step,pairs_per_grain,touching_fraction\n")
@@ -92,7 +74,7 @@ def run_one(bin_dir, out, docs, name, seed, extra=(), tag=None):
             if t - last >= 1e-3 - 1e-9 or r is rows[-1]:
                 g.write(",".join([r[0], r[2], r[4], r[5], r[6], r[7], r[8]]) + "\n")
                 last = t
-    print("%s: %s (%.0f s)" % (tag, line(s), wall), flush=True)
+    print("%s: %s (%.0f s)" % (tag, line(s), s["campaign"]["wall_seconds"]), flush=True)
     return s
 
 
@@ -133,18 +115,13 @@ def calibrate(bin_dir, out, docs):
 
 
 def main():
-    if len(sys.argv) < 5:
-        raise SystemExit(__doc__)
-    bin_dir, out, docs, cmd = sys.argv[1:5]
-    os.makedirs(out, exist_ok=True)
-    os.makedirs(docs, exist_ok=True)
+    bin_dir, out, docs, cmd, names = campaign_cli.command_line(__doc__)
     if cmd == "calibrate":
         calibrate(bin_dir, out, docs)
     elif cmd == "run":
-        names = sys.argv[5:] or list(RUNS)
+        names = names or list(RUNS)
+        campaign_cli.check_names(names, RUNS)
         for n in names:
-            if n not in RUNS:
-                raise SystemExit("unknown run '%s' (%s)" % (n, " ".join(RUNS)))
             for seed in RUNS[n][1]:
                 run_one(bin_dir, out, docs, n, seed)
     elif cmd == "report":

@@ -6,6 +6,10 @@ import glob
 import json
 import math
 import os
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
+import campaign_cli  # noqa: E402
 
 import matplotlib
 
@@ -85,9 +89,8 @@ def report(docs, RUNS):
              "up / down crossings | max pairs per grain above | max touching fraction | wall (s) |",
              "|---|---|---|---|---|---|---|---|---|---|"]
     failed = {}
-    for f in sorted(glob.glob(os.path.join(docs, "*_s*", "failed.txt"))):
-        tag = os.path.basename(os.path.dirname(f))
-        failed.setdefault(tag.rsplit("_s", 1)[0], []).append((tag, open(f).read().strip()))
+    for tag, text in campaign_cli.failures(docs):
+        failed.setdefault(tag.rsplit("_s", 1)[0], []).append((tag, text))
     for name, (ov, seeds, what) in RUNS.items():
         rs = runs.get(name, [])
         if name in failed:
@@ -111,11 +114,7 @@ def report(docs, RUNS):
         lines.append("| %s | %s | %d of %d | %s | %s | %s | %.0f / %.0f | %s | %s | %.0f |" % (
             name, what, len(rs), len(seeds), fmt(*rate), fmt(*area), dep_txt, up[0], down[0], fmt(*pairs),
             fmt(*mean_sd(touch)), wall[0]))
-    if failed:
-        lines += ["", "Runs that stopped (the engine's guards; their partial output is not used):", ""]
-        for name in failed:
-            for tag, text in failed[name]:
-                lines.append("- `%s`: %s" % (tag, " ".join(text.split())))
+    lines += campaign_cli.failure_lines(docs)
     lines += ["", "Published statements each run can be compared with (Berger et al. 2013):", ""]
     for k, v in PUBLISHED.items():
         lines.append("- `%s`%s: %s" % (k, " (every ε–μ run)" if k == "e" else "", v))

@@ -113,8 +113,14 @@ def report(docs):
         alpha = power_fit(*zip(*ok))[1] if len(ok) >= 3 else float("nan")
         b = rs[0]["bed"]
         nb = sum(1 for s in rs if s["result"]["bounced"])
-        law = "%.4g N, %.4g 1/m (rms %.2g mm)" % tuple(x * f for x, f in zip(law_fit(v, z), (1, 1, 1e3))) \
-            if len(rs) >= 5 else "(needs 5 speeds)"
+        law = "(needs 5 speeds)"
+        if len(rs) >= 5:
+            f0, k, rms = law_fit(v, z)
+            law = "%.4g N, %.4g 1/m (rms %.2g mm)" % (f0, k, rms * 1e3)
+            vv = [max(v) * i / 50 for i in range(51)]
+            c = f0 - 9.81
+            ax[0].plot(vv, [100 * (0.5 * x * x / c if k == 0 else 0.5 / k * math.log1p(x * x / c * k)) for x in vv],
+                       "--", lw=0.8, color="gray")
         lines.append("| %s | %d | %.0f | %.3f | %d | %.3f | %s | %d of %d |" % (
             bed, b["grains"], b["bulk_density"], b["packing_fraction"], len(rs), alpha, law, nb, len(rs)))
         ax[0].plot(v, [x * 100 for x in z], "o-", label=bed)
@@ -127,7 +133,7 @@ def report(docs):
                 r["duration_1cm_s"] * 1e3, r["duration_1mm_s"] * 1e3, r["f0"], r["inv_d1"],
                 "yes" if r["bounced"] else "no"))
     ax[0].set_xlabel("impact speed V (m/s)")
-    ax[0].set_ylabel("stopping depth z_stop (cm)")
+    ax[0].set_ylabel("stopping depth z_stop (cm); dashed: force law across speeds")
     ax[1].set_xlabel("total drop height H (m)")
     ax[1].set_ylabel("z_stop (m)")
     ax[2].set_xlabel("impact speed V (m/s)")

@@ -115,10 +115,11 @@ def report(docs):
         nb = sum(1 for s in rs if s["result"]["bounced"])
         law = "(needs 5 speeds)"
         if len(rs) >= 5:
-            f0, k, rms = law_fit(v, z)
+            mass, g = rs[0]["input"]["sphere_mass"], rs[0]["input"]["gravity"]
+            f0, k, rms = law_fit(v, z, mass, g)
             law = "%.4g N, %.4g 1/m (rms %.2g mm)" % (f0, k, rms * 1e3)
             vv = [max(v) * i / 50 for i in range(51)]
-            c = f0 - 9.81
+            c = f0 / mass - g
             ax[0].plot(vv, [100 * (0.5 * x * x / c if k == 0 else 0.5 / k * math.log1p(x * x / c * k)) for x in vv],
                        "--", lw=0.8, color="gray")
         lines.append("| %s | %d | %.0f | %.3f | %d | %.3f | %s | %d of %d |" % (

@@ -277,8 +277,11 @@ bool Run::advance() {
 void Run::watch_energy() {
   const Guards& gd = m_.guards;
   if (!(gd.max_energy_growth > 0) || gd.energy_check_every <= 0) return;
-  // Energy put in this step: a field, an applied wrench, the stiffness schedule, held grains.
-  bool input = !m_.fields.empty() || sched_on_ || !held_ids_.empty();
+  // Energy put in this step: a field, an applied wrench, the stiffness schedule, held grains, or
+  // gravity along a periodic axis (a grain wrapped downhill keeps its speed but its potential
+  // energy jumps up by m g L: an inclined periodic bed is driven without bound; docs/model.md §13).
+  const bool periodic_drive = (m_.periodic.x && m_.gravity.x() != 0) || (m_.periodic.y && m_.gravity.y() != 0);
+  bool input = !m_.fields.empty() || sched_on_ || !held_ids_.empty() || periodic_drive;
   for (size_t b = 0; b < s_.body_applied_force.size() && !input; ++b)
     input = s_.body_applied_force[b] != Vec3::Zero() || s_.body_applied_torque[b] != Vec3::Zero();
   energy_input_ = energy_input_ || input;

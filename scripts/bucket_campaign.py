@@ -134,24 +134,16 @@ def report(docs):
                 r["duration_1cm_s"] * 1e3, r["duration_1mm_s"] * 1e3, r["f0"], r["inv_d1"],
                 "yes" if r["bounced"] else "no"))
     ax[0].set_xlabel("impact speed V (m/s)")
-    ax[0].set_ylabel("stopping depth z_stop (cm); dashed: force law across speeds")
+    ax[0].set_ylabel("z_stop (cm); dashed: law across speeds")
     ax[1].set_xlabel("total drop height H (m)")
     ax[1].set_ylabel("z_stop (m)")
     ax[2].set_xlabel("impact speed V (m/s)")
     ax[2].set_ylabel("collision duration to 1 cm/s (ms)")
-    for a in ax:
-        a.grid(alpha=0.3)
-    ax[0].legend(fontsize=7)
-    fig.tight_layout()
-    if rows:
-        fig.savefig(os.path.join(docs, "bucket.png"), dpi=110)
-        lines += ["", "![stopping depth, power law and durations](bucket.png)"]
-    plt.close(fig)
     lines += campaign_cli.failure_lines(docs)
     lines += ["", "| bed | V (m/s) | z_stop (cm) | H (cm) | to 1 cm/s (ms) | to 1 mm/s (ms) | f₀ (N) | 1/d₁ (1/m) | "
               "bounced |", "|---|---|---|---|---|---|---|---|---|"] + detail
-    with open(os.path.join(docs, "report.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
+    campaign_cli.write_report(docs, lines, fig, ax, "bucket.png" if rows else None,
+                              "stopping depth, power law and durations")
     print("bucket report: %s" % os.path.join(docs, "report.md"))
 
 

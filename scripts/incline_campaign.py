@@ -148,16 +148,8 @@ def report(docs):
     ax[2].set_xscale("log")
     ax[2].set_xlabel("inertial number I")
     ax[2].set_ylabel("mu = tan theta")
-    for a in ax:
-        a.grid(alpha=0.3)
-        a.legend(fontsize=7)
-    fig.tight_layout()
-    if done:
-        fig.savefig(os.path.join(docs, "incline.png"), dpi=110)
-        lines += ["", "![velocity and packing profiles, mu(I)](incline.png)"]
-    plt.close(fig)
-    with open(os.path.join(docs, "report.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
+    campaign_cli.write_report(docs, lines, fig, ax, "incline.png" if done else None,
+                              "velocity and packing profiles, mu(I)")
     print("incline report: %s" % os.path.join(docs, "report.md"))
 
 

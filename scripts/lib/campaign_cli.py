@@ -80,3 +80,22 @@ def failure_lines(docs):
         return []
     return ["", "Runs that stopped (the engine's guards or input checks; their partial output is not used):", ""] + [
         "- `%s`: %s" % (d, t) for d, t in fs]
+
+
+def write_report(docs, lines, fig, axes, png, caption, legend=True, name="report.md"):
+    """Grid (and legends) on the axes; the figure saved as DOCS/PNG with its markdown line when there
+    is data (lines is not only the header), and DOCS/report.md written. Returns the report's path."""
+    import matplotlib.pyplot as plt
+    for a in axes:
+        a.grid(alpha=0.3)
+        if legend and a.get_legend_handles_labels()[0]:
+            a.legend(fontsize=7)
+    fig.tight_layout()
+    if png:
+        fig.savefig(os.path.join(docs, png), dpi=110)
+        lines = lines + ["", "![%s](%s)" % (caption, png)]
+    plt.close(fig)
+    path = os.path.join(docs, name)
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    return path

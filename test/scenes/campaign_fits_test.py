@@ -1,0 +1,66 @@
+#!/usr/bin/python3
+"""The fits of the laboratory campaigns against exact data (docs/validation.md "Bucket impact",
+"Inclined plane"): the force law across impact speeds, the layer's acceleration and base friction,
+and mu(I)."""
+import math
+import os
+import sys
+import tempfile
+import unittest
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
+import bucket_campaign  # noqa: E402
+import incline_campaign  # noqa: E402
+
+
+class BucketLawFit(unittest.TestCase):
+    def test_exact_law_is_recovered(self):
+        f0, k, m, g = 30.0, 20.0, 1.0, 9.81
+        vs = [0.1 * i for i in range(1, 11)]
+        ps = [0.5 / k * math.log1p(v * v / (f0 / m - g) * k) for v in vs]
+        f, kk, rms = bucket_campaign.law_fit(vs, ps)
+        self.assertAlmostEqual(f / f0, 1.0, delta=1e-3)
+        self.assertAlmostEqual(kk / k, 1.0, delta=1e-3)
+        self.assertLess(rms, 1e-5)
+
+    def test_constant_resistance_gives_no_inertial_term(self):
+        f0, g = 45.0, 9.81
+        vs = [0.1 * i for i in range(1, 11)]
+        ps = [v * v / (2 * (f0 - g)) for v in vs]
+        f, kk, rms = bucket_campaign.law_fit(vs, ps)
+        self.assertAlmostEqual(f / f0, 1.0, delta=1e-3)
+        self.assertLess(kk, 0.5)
+        self.assertLess(rms, 1e-5)
+
+
+class InclineFits(unittest.TestCase):
+    def test_mu_i_recovered_from_exact_points(self):
+        mu1, mu2, i0 = 0.38, 0.64, 0.28
+        pts = [(i, mu1 + (mu2 - mu1) / (i0 / i + 1)) for i in (0.01, 0.03, 0.1, 0.3, 1.0)]
+        a, b, c, rms = incline_campaign.fit_mu_i(pts)
+        self.assertAlmostEqual(a, mu1, delta=2e-3)
+        self.assertAlmostEqual(b, mu2, delta=2e-3)
+        self.assertAlmostEqual(c / i0, 1.0, delta=0.03)  # I0 on a grid of 80 points per decade
+        self.assertLess(rms, 1e-3)
+
+    def test_acceleration_and_base_friction(self):
+        with tempfile.TemporaryDirectory() as d:
+            with open(os.path.join(d, "series.csv"), "w") as f:
+                f.write("t,theta_deg,mean_vx\n")
+                for k in range(401):
+                    t = 0.01 * k
+                    f.write("%.6f,33,%.9f\n" % (t, 0.2 + 0.4 * t))
+            v0, v1, a = incline_campaign.acceleration(d)
+        self.assertAlmostEqual(a, 0.4, delta=1e-6)
+        self.assertAlmostEqual(v0, 1.4, delta=1e-6)
+        self.assertAlmostEqual(v1, 1.8, delta=1e-6)
+        th = math.radians(33)
+        o = {"theta_deg": 33}
+        self.assertAlmostEqual(incline_campaign.base_friction(o, 0.0), math.tan(th), delta=1e-12)
+        # dV/dt = g (sin - mu cos) inverted
+        mu = incline_campaign.base_friction(o, 0.4)
+        self.assertAlmostEqual(9.81 * (math.sin(th) - mu * math.cos(th)), 0.4, delta=1e-12)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -40,7 +40,7 @@ RUNS = {
 STEADY = {"moderate": [30, 31, 32, 33, 34], "gravel": [40, 42]}
 for m, angles in STEADY.items():
     for a in angles:
-        RUNS["%s_%d" % (m, a)] = (mat(m) + ["incline.angle_deg=%d" % a], "steady flow, %s at %d deg" % (m, a))
+        RUNS["%s_%d" % (m, a)] = (mat(m) + ["incline.angle_deg=%d" % a], "flow at a fixed angle, %s at %d deg" % (m, a))
 
 
 def run_one(bin_dir, out, docs, name):

@@ -81,6 +81,11 @@ def fit_mu_i(points):
     return best
 
 
+def fit_resolved(mu1, mu2, i0):
+    """A mu(I) fit the points determine: 0 <= mu1 < mu2 and I0 inside its grid (not on an edge)."""
+    return 0 <= mu1 < mu2 and 1.01e-4 < i0 < 9.9
+
+
 def acceleration(keep, window=1.0):
     """(v at the window's start, v at its end, slope) of the mean downslope speed over the last
     `window` s of DOCS/RUN/series.csv (least squares), or None without the file."""
@@ -165,6 +170,12 @@ def report(docs):
             ax[2].plot([p[0] for p in tans], [p[1] for p in tans], "x", color="gray", label="%s: tan theta" % m)
         if len(pts) >= 4:
             mu1, mu2, i0, rms = fit_mu_i(pts)
+            if not fit_resolved(mu1, mu2, i0):
+                fits.append("| %s | %d | not resolved: the least-squares I0 (%.3g) lies on the grid's edge or "
+                            "mu1 (%.3g) outside 0 .. mu2 (%.3g); mu_b spans %.4f-%.4f over I = %.3g-%.3g | | | %.2g |" % (
+                                m, len(pts), i0, mu1, mu2, min(p[1] for p in pts), max(p[1] for p in pts),
+                                min(p[0] for p in pts), max(p[0] for p in pts), rms))
+                continue
             fits.append("| %s | %d | %.4f (%.1f°) | %.4f (%.1f°) | %.3g | %.2g |" % (
                 m, len(pts), mu1, math.degrees(math.atan(mu1)), mu2, math.degrees(math.atan(mu2)), i0, rms))
             ii = [min(p[0] for p in pts) * 0.5 * 1.05 ** k for k in range(200)]

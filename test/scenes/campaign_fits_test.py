@@ -42,6 +42,11 @@ class InclineFits(unittest.TestCase):
         self.assertAlmostEqual(b, mu2, delta=2e-3)
         self.assertAlmostEqual(c / i0, 1.0, delta=0.03)  # I0 on a grid of 80 points per decade
         self.assertLess(rms, 1e-3)
+        self.assertTrue(incline_campaign.fit_resolved(a, b, c))
+
+    def test_flat_noisy_points_are_not_resolved(self):
+        pts = [(0.045, 0.5946), (0.083, 0.6068), (0.137, 0.6003), (0.175, 0.6116)]
+        self.assertFalse(incline_campaign.fit_resolved(*incline_campaign.fit_mu_i(pts)[:3]))
 
     def test_acceleration_and_base_friction(self):
         with tempfile.TemporaryDirectory() as d:

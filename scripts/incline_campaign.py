@@ -5,7 +5,7 @@
   incline_campaign.py BIN OUT DOCS report         DOCS/report.md and incline.png
 
 Runs: onset_MAT (1-degree steps from rest, MAT = moderate or gravel) and MAT_ANGLE
-(steady flow at ANGLE degrees: profiles over the last second, Bagnold fit, I). A
+(flow at a fixed ANGLE: profiles over the last second, Bagnold fit, I). A
 finished run's summary.json (with profile.csv and series.csv) goes to DOCS/RUN/ (committed:
 a campaign resumes on any machine; INCLINE_RERUN=1 runs them again); a run
 that stopped leaves failed.txt there, not retried.
@@ -36,8 +36,8 @@ RUNS = {
     "tilt30_moderate": (mat("moderate") + ["incline.mode=onset", "incline.start_deg=30", "incline.max_deg=30"],
                         "moderate tilted at once from rest to 30 deg (one 1 s hold)"),
 }
-# Steady angles: the settled bed tilted at once flows from 30 deg (moderate), and at 34 deg it still
-# accelerates after 4 s (docs/validation.md "Inclined plane"), so the steady window is 30-33 deg.
+# Fixed angles around the flowing friction of moderate: at 30 deg the bed tilted at once flows and stops,
+# at 33-34 deg it still accelerates after 4 s (docs/validation.md "Inclined plane").
 STEADY = {"moderate": [30, 31, 32, 33, 34], "gravel": [40, 42]}
 for m, angles in STEADY.items():
     for a in angles:
@@ -55,11 +55,14 @@ def run_one(bin_dir, out, docs, name):
               flush=True)
 
 
+I0_GRID = (1e-4, 10.0)  # the range of I0 the mu(I) fit searches
+
+
 def fit_mu_i(points):
     """Least squares of mu(I) = mu1 + (mu2 - mu1) / (I0 / I + 1): (mu1, mu2, I0, rms)."""
     best = None
     for k in range(401):
-        i0 = 10 ** (-4 + 5 * k / 400.0)
+        i0 = I0_GRID[0] * (I0_GRID[1] / I0_GRID[0]) ** (k / 400.0)
         # mu = mu1 (1 - f) + mu2 f with f = I / (I0 + I): linear in (mu1, mu2)
         a11 = a12 = a22 = b1 = b2 = 0.0
         for i, mu in points:
@@ -83,7 +86,7 @@ def fit_mu_i(points):
 
 def fit_resolved(mu1, mu2, i0):
     """A mu(I) fit the points determine: 0 <= mu1 < mu2 and I0 inside its grid (not on an edge)."""
-    return 0 <= mu1 < mu2 and 1.01e-4 < i0 < 9.9
+    return 0 <= mu1 < mu2 and 1.01 * I0_GRID[0] < i0 < 0.99 * I0_GRID[1]
 
 
 def acceleration(keep, window=1.0):
@@ -145,12 +148,11 @@ def report(docs):
     fig, ax = plt.subplots(1, 3, figsize=(14, 4.2))
     fits = []
     for m in STEADY:
-        pts, tans, runs = [], [], []
+        pts, tans = [], []
         for a in STEADY[m]:
             n = "%s_%d" % (m, a)
             if n in done:
                 o = done[n]["observers"]["incline"]
-                runs.append(n)
                 acc = acceleration(os.path.join(docs, n))
                 if o["inertial_number"] > 0 and acc is not None:
                     pts.append((o["inertial_number"], base_friction(o, acc[2])))

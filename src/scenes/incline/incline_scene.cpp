@@ -76,6 +76,10 @@ double bagnold_inertial_number(double a, double d, double h, double phi, double 
   return 3 * d * a / (2 * std::pow(h, 1.5) * std::sqrt(phi * g * std::cos(theta)));
 }
 
+bool onset_flowing(double v_end, double dvdt_end, double hold, double threshold) {
+  return v_end > threshold && v_end + dvdt_end * hold > threshold;
+}
+
 // --- the observer -------------------------------------------------------------------
 
 void InclineObserver::tilt(Model& m, State& s, double deg) {
@@ -107,16 +111,24 @@ double InclineObserver::mean_vx(const Model& m, const State& s) const {
 
 bool InclineObserver::after_step(Model& m, State& s) {
   if (sp_.onset) {
-    if (s.time - hold_from_ < sp_.hold - 0.5 * m.dt) return false;
+    const double held = s.time - hold_from_;
+    if (!marked_ && held >= (1 - kTrendWindow) * sp_.hold - 0.5 * m.dt) {
+      marked_ = true;  // the start of the window the hold-end trend is read over
+      mark_t_ = s.time;
+      mark_v_ = mean_vx(m, s);
+    }
+    if (held < sp_.hold - 0.5 * m.dt) return false;
     const double v = mean_vx(m, s);
-    holds_.push_back({theta_deg_, v});
-    if (v > sp_.flow_speed * std::sqrt(g_ * d_)) {
+    const double dvdt = s.time > mark_t_ ? (v - mark_v_) / (s.time - mark_t_) : 0;
+    holds_.push_back({theta_deg_, v, dvdt});
+    if (onset_flowing(v, dvdt, sp_.hold, sp_.flow_speed * std::sqrt(g_ * d_))) {
       onset_deg_ = theta_deg_;
-      return true;  // flowing at the end of its hold: the onset angle
+      return true;  // flowing at the end of its hold, and not dying out: the onset angle
     }
     if (theta_deg_ + sp_.step_deg > sp_.max_deg + 1e-9) return true;
     tilt(m, s, theta_deg_ + sp_.step_deg);
     hold_from_ = s.time;
+    marked_ = false;
     return false;
   }
   // Steady: sample the layers every sample interval over the last `average` s.
@@ -175,12 +187,13 @@ void InclineObserver::summary(JsonObject& out) const {
   o.str("mode", sp_.onset ? "onset" : "steady").num("theta_deg", theta_deg_);
   if (sp_.onset) {
     o.num("onset_deg", onset_deg_);
-    std::vector<double> th, v;
+    std::vector<double> th, v, a;
     for (const auto& h : holds_) {
-      th.push_back(h.first);
-      v.push_back(h.second);
+      th.push_back(h.theta_deg);
+      v.push_back(h.v_end);
+      a.push_back(h.dvdt_end);
     }
-    o.nums("hold_angles_deg", th).nums("hold_end_mean_vx", v);
+    o.nums("hold_angles_deg", th).nums("hold_end_mean_vx", v).nums("hold_end_dvdt", a);
   } else {
     o.num("flow_height", prof_.height).num("packing_mean", prof_.packing_mean);
     o.num("bagnold_a", prof_.bagnold_a).num("bagnold_fit_rms", prof_.fit_rms);

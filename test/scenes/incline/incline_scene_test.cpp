@@ -1,7 +1,8 @@
 // The inclined-plane scene kind (docs/scenes.md C.2): the Bagnold fit gives
 // back the amplitude of an exact Bagnold profile, and the inertial number
-// of Bagnold's solution for a chosen I; bad input is refused; a flowing bed
-// wraps across the periodic boundary without tripping the energy guard.
+// of Bagnold's solution for a chosen I; the onset test takes a decelerating
+// transient for no flow and a sustained one for flow; bad input is refused; a
+// flowing bed wraps across the periodic boundary without tripping the energy guard.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -33,6 +34,57 @@ TEST(Bagnold, FitAndInertialNumberOfAnExactProfile) {
   std::vector<double> flat(z.size(), 1.0);
   rt::bagnold_amplitude(z, flat, h, &rms);
   EXPECT_GT(rms, 0.1);
+}
+
+TEST(InclineOnset, TheHoldEndTrendSeparatesATransientFromFlow) {
+  const double thr = 0.003;  // m/s
+  EXPECT_FALSE(rt::onset_flowing(0.002, 0.0, 1.0, thr));   // too slow
+  EXPECT_TRUE(rt::onset_flowing(0.01, 0.5, 1.0, thr));     // flowing and accelerating
+  EXPECT_TRUE(rt::onset_flowing(0.01, -0.005, 1.0, thr));  // easing towards a steady flow above the threshold
+  // Gravel tilted to 35 deg: surged to 0.35 m/s, left at 0.006 m/s at the end of a 1 s hold, still
+  // slowing at 0.12 m/s^2. Above the threshold, but it comes to rest well within one more hold.
+  EXPECT_FALSE(rt::onset_flowing(0.006, -0.12, 1.0, thr));
+}
+
+TEST(InclineOnset, AStepThroughAnglesSkipsADyingSurgeAndStopsAtSustainedFlow) {
+  // The observer driven with prescribed grain speeds: at rest at 30 deg, a surge that dies (still above
+  // the threshold at the end of the hold) at 31 deg, and an accelerating flow at 32 deg. A hold-end speed
+  // alone would call 31 deg the onset.
+  rt::InclineSpec sp;
+  sp.onset = true;
+  sp.start_deg = 30;
+  sp.max_deg = 35;
+  sp.hold = 0.1;
+  const double d = 0.01, g = 9.81;  // threshold 0.01 sqrt(g d) = 3.1 mm/s
+  rt::InclineObserver ob(sp, 0.0, 0.1, d, 0.02, g);
+  rt::Model m;
+  m.n_grains = 2;
+  m.grain_inv_mass = {1.0, 1.0};
+  m.dt = 1e-3;
+  rt::State s;
+  s.pos.assign(2, rt::Vec3::Zero());
+  s.vel.assign(2, rt::Vec3::Zero());
+  ob.prepare(m, s);
+  EXPECT_DOUBLE_EQ(ob.theta_deg(), 30);
+  double theta = ob.theta_deg(), t0 = 0;
+  bool done = false;
+  for (int k = 0; k < 1000 && !done; ++k) {
+    s.time += m.dt;
+    ++s.step;
+    const double t = s.time - t0;
+    double v = 0;
+    if (theta == 31) v = 0.05 * (1 - t / 0.11);  // 4.5 mm/s at the end of the hold, slowing at 0.45 m/s^2
+    if (theta == 32) v = 0.02 + 0.5 * t;
+    for (auto& u : s.vel) u = rt::Vec3(v, 0, 0);
+    done = ob.after_step(m, s);
+    if (ob.theta_deg() != theta) {
+      theta = ob.theta_deg();
+      t0 = s.time;
+    }
+  }
+  ASSERT_TRUE(done);
+  EXPECT_DOUBLE_EQ(ob.onset_deg(), 32);
+  EXPECT_NEAR(m.gravity.x(), g * std::sin(32 * kPi / 180), 1e-12);
 }
 
 TEST(InclineScene, BadInputIsRefused) {

@@ -3,8 +3,11 @@
 // gravity is then tilted by theta about the y axis (flow along +x).
 //   mode onset:  theta raised from `start_deg` in `step_deg` steps, each held
 //                `hold` s; the onset angle is the first at which the bed is
-//                still flowing (mean v_x of the free grains above
-//                `flow_speed` sqrt(g d)) at the end of its hold;
+//                still flowing at the end of its hold (mean v_x of the free
+//                grains above `flow_speed` sqrt(g d)) and not dying out: the
+//                trend dv/dt over the hold's last quarter, carried over one
+//                more hold, must leave it above that speed (a transient
+//                surge that is decelerating to rest is not onset);
 //   mode steady: theta fixed; over the last `average` s of the run, the
 //                velocity and packing profiles in horizontal layers, the
 //                Bagnold fit v_x(z) = A [1 - (1 - z/h)^(3/2)] and the inertial
@@ -44,6 +47,9 @@ struct Profile {
 double bagnold_amplitude(const std::vector<double>& z, const std::vector<double>& v, double h, double* rms);
 // I = 3 d A / (2 h^(3/2) sqrt(Phi g cos theta)).
 double bagnold_inertial_number(double a, double d, double h, double phi, double g, double theta);
+// The onset test at the end of a hold: v_end above `threshold`, and still above it after one more hold
+// at the hold-end trend, v_end + dvdt_end hold (m/s, m/s^2, s).
+bool onset_flowing(double v_end, double dvdt_end, double hold, double threshold);
 
 class InclineObserver : public Observer {
  public:
@@ -68,8 +74,14 @@ class InclineObserver : public Observer {
   void tilt(Model& m, State& s, double deg);
   InclineSpec sp_;
   double base_, top_, d_, area_, g_;
+  static constexpr double kTrendWindow = 0.25;  // onset: the hold-end trend is read over this fraction of the hold
+  struct Hold {
+    double theta_deg, v_end, dvdt_end;  // the tilt, mean v_x at the end of its hold, and its trend there
+  };
   double theta_deg_ = 0, onset_deg_ = -1, hold_from_ = 0;
-  std::vector<std::pair<double, double>> holds_;  // (theta, mean v_x at the end of its hold)
+  bool marked_ = false;
+  double mark_t_ = 0, mark_v_ = 0;
+  std::vector<Hold> holds_;
   std::vector<double> sum_vx_, sum_vol_;
   std::vector<long> count_;
   long samples_ = 0;

@@ -135,10 +135,10 @@ def report(docs):
         w = done[n]["campaign"]["wall_seconds"]
         if o["mode"] == "onset":
             trend = o.get("hold_end_dvdt", [])
-            ends = ["%.0f°: %.2g" % (a, v) + (" (%+.2g m/s²)" % trend[k] if k < len(trend) else "")
+            ends = ["%.0f°: %.2g m/s" % (a, v) + (" (%+.2g m/s²)" % trend[k] if k < len(trend) else "")
                     for k, (a, v) in enumerate(zip(o["hold_angles_deg"], o["hold_end_mean_vx"]))]
             res = ("onset at %.0f deg" % o["onset_deg"] if o["onset_deg"] >= 0 else "no onset up to the last hold") + \
-                " (hold-end mean v_x and trend: %s m/s)" % ", ".join(ends)
+                " (hold-end mean v_x and its trend: %s)" % ", ".join(ends)
         else:
             res = "A = %.4g m/s, h = %.1f d, Phi = %.3f, I = %.4g, tan theta = %.4f, fit rms %.2g m/s" % (
                 o["bagnold_a"], o["flow_height"] / done[n]["bed"]["diameter"], o["packing_mean"],

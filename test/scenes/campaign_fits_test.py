@@ -59,6 +59,18 @@ class InclineFits(unittest.TestCase):
         self.assertAlmostEqual(a, 0.4, delta=1e-6)
         self.assertAlmostEqual(v0, 1.4, delta=1e-6)
         self.assertAlmostEqual(v1, 1.8, delta=1e-6)
+        # A 2 s window (the 8 s series) starts a second earlier on the same line.
+        with tempfile.TemporaryDirectory() as d:
+            with open(os.path.join(d, "series.csv"), "w") as f:
+                f.write("t,theta_deg,mean_vx\n")
+                for k in range(801):
+                    t = 0.01 * k
+                    f.write("%.6f,31,%.9f\n" % (t, 0.5 + 0.1 * min(t, 7.0)))
+            v0, v1, a = incline_campaign.acceleration(d, incline_campaign.window_of("moderate_8s_31"))
+        self.assertAlmostEqual(v0, 1.1, delta=1e-6)  # at 6 s (a 1 s window would start at 7 s: 1.2)
+        self.assertAlmostEqual(v1, 1.2, delta=1e-6)
+        self.assertGreater(a, 0.01)  # the ramp runs on to 7 s inside the window
+        self.assertEqual(incline_campaign.window_of("moderate_31"), 1.0)
         th = math.radians(33)
         o = {"theta_deg": 33}
         self.assertAlmostEqual(incline_campaign.base_friction(o, 0.0), math.tan(th), delta=1e-12)

@@ -8,7 +8,9 @@ Beds: glass_beads or glass_beads_b, cut at 8, 10 or 12 cm (gb_8 ... gbb_12), and
 gb_10_5mm (5 mm beads, 10 cm: the costly one, not in the default list). A
 finished run's summary.json and impact.csv are copied to DOCS/BED_vSPEED/
 (committed: a campaign resumes on any machine; BUCKET_RERUN=1 runs again); a
-run that stopped leaves failed.txt there, not retried.
+run that stopped leaves failed.txt there, not retried. BUCKET_SPEEDS=0.3,0.7 runs
+only those speeds (two queues on one bed, each with its own speeds, share a core
+each once the bed is cached); BUCKET_THREADS threads per run (default 1).
 """
 import json
 import math
@@ -156,8 +158,14 @@ def main():
     if cmd == "run":
         beds = beds or DEFAULT
         campaign_cli.check_names(beds, BEDS, "bed")
+        only = [float(x) for x in os.environ.get("BUCKET_SPEEDS", "").split(",") if x.strip()]
+        bad = [v for v in only if v not in SPEEDS]
+        if bad:
+            raise SystemExit("BUCKET_SPEEDS: %s not among the campaign's speeds %s" % (bad, SPEEDS))
         for b in beds:
             for v in ORDER.get(b, SPEEDS):
+                if only and v not in only:
+                    continue
                 run_one(bin_dir, out, docs, b, v, threads)
     elif cmd == "report":
         report(docs)

@@ -30,8 +30,8 @@ BEDS["gb_10_5mm"] = ["materials.beads.preset=glass_beads", "grains.0.radius=0.00
                      "stages.1.trim_above=0.0975"]
 DEFAULT = ["gb_10", "gbb_10", "gb_8", "gb_12", "gbb_8", "gbb_12"]
 # The costly bed runs its speeds spread out first, so that a campaign cut short
-# across sittings still spans 0.1-1.0 m/s and fits the force law early; the slow
-# impacts, which take longest to come to rest (0.2 m/s), come late.
+# across sittings still spans 0.1-1.0 m/s and fits the force law early; 0.2 and
+# 0.9 m/s, each next to speeds already run, come last.
 ORDER = {"gb_10_5mm": [0.1, 1.0, 0.5, 0.3, 0.7, 0.8, 0.4, 0.6, 0.2, 0.9]}
 
 

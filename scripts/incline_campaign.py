@@ -164,8 +164,8 @@ def report(docs):
                 o["inertial_number"], o["mu"], o["bagnold_fit_rms"])
             acc = acceleration(os.path.join(docs, n), window_of(n))
             if acc is not None:
-                res += "; mean v_x %.3g -> %.3g m/s over the last second (dV/dt %.3g m/s², mu_b = %.4f)" % (
-                    acc[0], acc[1], acc[2], base_friction(o, acc[2]))
+                res += "; mean v_x %.3g -> %.3g m/s over the last %g s (dV/dt %.3g m/s², mu_b = %.4f)" % (
+                    acc[0], acc[1], window_of(n), acc[2], base_friction(o, acc[2]))
         lines.append("| %s | %s | %s | %.0f |" % (n, what, res, w))
     fig, ax = plt.subplots(1, 3, figsize=(14, 4.2))
     fits = []

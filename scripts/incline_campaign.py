@@ -36,22 +36,25 @@ RUNS = {
     "tilt30_moderate": (mat("moderate") + ["incline.mode=onset", "incline.start_deg=30", "incline.max_deg=30"],
                         "moderate tilted at once from rest to 30 deg (one 1 s hold)"),
 }
-# Fixed-angle series: (material, angles, extra overrides, the window in s over which profiles and dV/dt
-# are taken). Around the flowing friction of moderate: at 30 deg the bed tilted at once flows and stops,
+# Fixed-angle series: (material, angles, run duration in s, the window in s at its end over which
+# profiles and dV/dt are taken; config/incline_moderate.yaml has 4 s and 1 s). Around the flowing friction of moderate: at 30 deg the bed tilted at once flows and stops,
 # at 33-34 deg it still accelerates after 4 s (docs/validation.md "Inclined plane"); the 8 s series
 # holds the window of steady flow (30.5-32 deg) twice as long and reads the last 2 s.
 SERIES = {
-    "moderate": ("moderate", [30, 31, 32, 33, 34], [], 1.0),
-    "gravel": ("gravel", [40, 42], [], 1.0),
-    "moderate_8s": ("moderate", [30.5, 31, 31.5, 32], ["incline.duration=8", "incline.average=2"], 2.0),
+    "moderate": ("moderate", [30, 31, 32, 33, 34], 4.0, 1.0),
+    "gravel": ("gravel", [40, 42], 4.0, 1.0),
+    "moderate_8s": ("moderate", [30.5, 31, 31.5, 32], 8.0, 2.0),
 }
+CONFIG_DURATION, CONFIG_WINDOW = 4.0, 1.0
 
 
 def series_run(key, a):
     return "%s_%g" % (key, a)
 
 
-for key, (m, angles, extra, _) in SERIES.items():
+for key, (m, angles, duration, window) in SERIES.items():
+    extra = ([] if duration == CONFIG_DURATION else ["incline.duration=%g" % duration]) + \
+        ([] if window == CONFIG_WINDOW else ["incline.average=%g" % window])
     for a in angles:
         RUNS[series_run(key, a)] = (mat(m) + ["incline.angle_deg=%g" % a] + extra,
                                     "flow at a fixed angle, %s at %g deg%s" % (
@@ -127,7 +130,8 @@ def base_friction(o, a, g=9.81):
 
 def window_of(name):
     """The averaging window (s) of a fixed-angle run."""
-    return next((w for k, (_, angles, _, w) in SERIES.items() for a in angles if series_run(k, a) == name), 1.0)
+    return next((w for k, (_, angles, _, w) in SERIES.items() for a in angles if series_run(k, a) == name),
+                CONFIG_WINDOW)
 
 
 def report(docs):

@@ -73,6 +73,7 @@ def run_one(bin_dir, out, docs, name):
 
 
 I0_GRID = (1e-4, 10.0)  # the range of I0 the mu(I) fit searches
+I_PLOT_MIN = 1e-3  # the left edge of the mu(I) panel
 
 
 def fit_mu_i(points):
@@ -194,8 +195,12 @@ def report(docs):
                     ax[1].plot([float(r[2]) for r in rows if float(r[0]) < h], z, "o-", ms=3,
                                label="%s %g°" % (m, a))
         if pts:
-            ax[2].plot([p[0] for p in pts], [p[1] for p in pts], "o", label="%s: mu_b" % m)
-            ax[2].plot([p[0] for p in tans], [p[1] for p in tans], "x", color="gray", label="%s: tan theta" % m)
+            # a flow that came to rest (I below the panel's edge) is drawn at the edge as a "<"
+            flowing = [p for p in pts if p[0] >= I_PLOT_MIN]
+            c = ax[2].plot([p[0] for p in flowing], [p[1] for p in flowing], "o", label="%s: mu_b" % m)[0].get_color()
+            rest = [p for p in pts if p[0] < I_PLOT_MIN]
+            ax[2].plot([I_PLOT_MIN] * len(rest), [p[1] for p in rest], "<", color=c)
+            ax[2].plot([max(p[0], I_PLOT_MIN) for p in tans], [p[1] for p in tans], "x", color="gray")
         if len(pts) >= 4:
             mu1, mu2, i0, rms = fit_mu_i(pts)
             if not fit_resolved(mu1, mu2, i0):
@@ -219,7 +224,8 @@ def report(docs):
     ax[1].set_xlabel("solid fraction")
     ax[1].set_ylabel("z / h")
     ax[2].set_xscale("log")
-    ax[2].set_xlabel("inertial number I")
+    ax[2].set_xlim(left=0.7 * I_PLOT_MIN)
+    ax[2].set_xlabel("inertial number I; gray x: tan theta; <: at rest (I < %g)" % I_PLOT_MIN)
     ax[2].set_ylabel("base friction mu_b")
     campaign_cli.write_report(docs, lines, fig, ax, "incline.png" if done else None,
                               "velocity and packing profiles, mu(I)")

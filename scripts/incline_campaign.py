@@ -37,9 +37,10 @@ RUNS = {
                         "moderate tilted at once from rest to 30 deg (one 1 s hold)"),
 }
 # Fixed-angle series: (material, angles, run duration in s, the window in s at its end over which
-# profiles and dV/dt are taken; config/incline_moderate.yaml has 4 s and 1 s). Around the flowing friction of moderate: at 30 deg the bed tilted at once flows and stops,
-# at 33-34 deg it still accelerates after 4 s (docs/validation.md "Inclined plane"); the 8 s series
-# holds the window of steady flow (30.5-32 deg) twice as long and reads the last 2 s.
+# profiles and dV/dt are taken; config/incline_moderate.yaml has 4 s and 1 s). Around the flowing
+# friction of moderate: at 30 deg the bed tilted at once flows and stops, at 33-34 deg it still
+# accelerates after 4 s; the 8 s series holds 30.5-32 deg, where the 4 s runs came closest to steady,
+# twice as long (docs/validation.md "Inclined plane": none of them is steady after 8 s either).
 SERIES = {
     "moderate": ("moderate", [30, 31, 32, 33, 34], 4.0, 1.0),
     "gravel": ("gravel", [40, 42], 4.0, 1.0),

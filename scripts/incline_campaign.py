@@ -37,7 +37,7 @@ RUNS = {
                         "moderate tilted at once from rest to 30 deg (one 1 s hold)"),
 }
 # Fixed-angle series: (material, angles, run duration in s, the window in s at its end over which
-# profiles and dV/dt are taken; config/incline_moderate.yaml has 4 s and 1 s). Around the flowing
+# profiles and dV/dt are taken; both are passed to every run of the series). Around the flowing
 # friction of moderate: at 30 deg the bed tilted at once flows and stops, at 33-34 deg it still
 # accelerates after 4 s; the 8 s series holds 30.5-32 deg, where the 4 s runs came closest to steady,
 # twice as long (docs/validation.md "Inclined plane": none of them is steady after 8 s either).
@@ -46,20 +46,19 @@ SERIES = {
     "gravel": ("gravel", [40, 42], 4.0, 1.0),
     "moderate_8s": ("moderate", [30.5, 31, 31.5, 32], 8.0, 2.0),
 }
-CONFIG_DURATION, CONFIG_WINDOW = 4.0, 1.0
 
 
 def series_run(key, a):
     return "%s_%g" % (key, a)
 
 
+WINDOW = {}  # fixed-angle run -> its window (s)
 for key, (m, angles, duration, window) in SERIES.items():
-    extra = ([] if duration == CONFIG_DURATION else ["incline.duration=%g" % duration]) + \
-        ([] if window == CONFIG_WINDOW else ["incline.average=%g" % window])
     for a in angles:
-        RUNS[series_run(key, a)] = (mat(m) + ["incline.angle_deg=%g" % a] + extra,
-                                    "flow at a fixed angle, %s at %g deg%s" % (
-                                        m, a, "" if not extra else " (%s)" % ", ".join(extra)))
+        RUNS[series_run(key, a)] = (
+            mat(m) + ["incline.angle_deg=%g" % a, "incline.duration=%g" % duration, "incline.average=%g" % window],
+            "flow at a fixed angle, %s at %g deg (%g s, profiles over the last %g s)" % (m, a, duration, window))
+        WINDOW[series_run(key, a)] = window
 
 
 def run_one(bin_dir, out, docs, name):
@@ -132,8 +131,7 @@ def base_friction(o, a, g=9.81):
 
 def window_of(name):
     """The averaging window (s) of a fixed-angle run."""
-    return next((w for k, (_, angles, _, w) in SERIES.items() for a in angles if series_run(k, a) == name),
-                CONFIG_WINDOW)
+    return WINDOW[name]
 
 
 def report(docs):
@@ -147,7 +145,8 @@ def report(docs):
              "Onset: the first angle, in 1-degree steps held 1 s from rest, at whose end the mean downslope speed",
              "exceeds 0.01 sqrt(g d) and stays above it after one more hold at its trend over the hold's last quarter",
              "(moderate from 25°, gravel from 35°). Fixed angle: the settled bed tilted at once,",
-             "profiles over the last 1 s of 4 s (the 8 s series: the last 2 s of 8 s); Bagnold v = A (1 - (1 - z/h)^1.5);",
+             "profiles over the last %s; Bagnold v = A (1 - (1 - z/h)^1.5);" % "; ".join(
+                 "%g s of %g s (%s)" % (w, d, k) for k, (_, _, d, w) in SERIES.items()),
              "I = 3 d A / (2 h^1.5 sqrt(Phi g cos theta)). A flow still accelerating is read by the momentum",
              "balance of the whole periodic layer: mu_b = tan theta - (dV/dt) / (g cos theta), dV/dt the least-squares",
              "slope of the mean downslope speed over that window (mu_b = tan theta for a steady flow).", "",

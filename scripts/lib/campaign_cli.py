@@ -36,10 +36,12 @@ def kept(keep, rerun_env):
     return None
 
 
-def run_and_keep(bin_dir, config, out_dir, keep, overrides, campaign, copies=(), threads=1):
-    """regolith_sim CONFIG --set OVERRIDE... into out_dir; its summary.json (with `campaign` and the
-    wall time added) and the files in `copies` go to keep. Returns the summary, or None if it stopped."""
+def run_and_keep(bin_dir, config, out_dir, keep, overrides, campaign, copies=(), threads=1, extra=()):
+    """regolith_sim CONFIG --set OVERRIDE... [EXTRA...] into out_dir; its summary.json (with `campaign`
+    and the wall time added) and the files in `copies` go to keep. Returns the summary, or None if it
+    stopped."""
     cmd = [os.path.join(bin_dir, "regolith_sim"), config, "--threads", str(threads), "--out", out_dir, "--quiet"]
+    cmd += list(extra)
     for o in overrides:
         cmd += ["--set", o]
     t0 = time.time()

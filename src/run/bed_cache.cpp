@@ -121,6 +121,7 @@ RelaxedBed relax_bed(Scenario& sc, const State& s0, const std::vector<int>& plac
       const double v[] = {double(st.trim), st.trim_above, st.duration, st.until_rms_speed, st.until_max_speed,
                           st.check_every, st.quench_every, double(st.minimize)};
       h = fnv1a(v, sizeof v, h);
+      if (st.trim_tops) h = fnv1a("tops", 4, h);  // beds trimmed by centre keep their keys
     }
     char buf[32];
     std::snprintf(buf, sizeof buf, "-c%016llx", static_cast<unsigned long long>(h));

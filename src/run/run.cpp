@@ -119,9 +119,10 @@ void Run::begin_stage() {
   const Stage& st = plan_.stages[k_];
   energy_watch_.reset();
   int removed = 0;
-  if (st.trim) {  // every grain above the trim height goes
+  if (st.trim) {  // every grain above the trim height goes (its centre, or its top with trim_tops)
     std::vector<uint8_t> drop(m_.n_grains, 0);
-    for (int i = 0; i < m_.n_grains; ++i) drop[i] = s_.pos[i].z() > st.trim_above;
+    for (int i = 0; i < m_.n_grains; ++i)
+      drop[i] = s_.pos[i].z() + (st.trim_tops ? m_.grain_radius[i] : 0.0) > st.trim_above;
     removed = remove_grains(m_, s_, drop, plan_.groups);
   }
   double injected = 0, kinetic = 0;

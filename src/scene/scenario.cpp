@@ -203,19 +203,38 @@ void parse_grains(const Reader& rd, Scenario& sc, const YAML::Node& g, const std
   } else if (g["fill"]) {
     const std::string fp = Reader::join(path, "fill");
     const YAML::Node f = rd.map(g, path, "fill", true);
-    rd.only(f, fp, {"shape", "lo", "hi", "center", "radius", "z", "count", "spacing", "jitter"});
+    rd.only(f, fp, {"shape", "lo", "hi", "center", "radius", "z", "count", "arrangement", "spacing", "jitter", "gap"});
     const RadiusDist dist = parse_radius(rd, g, path);
     const Region region = parse_region(rd, f, fp);
     const long count = rd.integer(f, fp, "count", 1000, 1, 50000000);
-    const double spacing = rd.number(f, fp, "spacing", 2.1 * dist.max(), 2 * dist.max(), kInf);
-    const double jitter = rd.number(f, fp, "jitter", 0.05 * (spacing - 2 * dist.max()) + 0.01 * dist.mean, 0,
-                                    0.5 * spacing);
-    pos = lattice_sites(region, spacing, dist.max(), jitter, int(count), rng);
-    if (long(pos.size()) < count)
-      rd.fail(Reader::join(fp, "count"), std::to_string(count) + " grains do not fit in the region at spacing " +
-                                              std::to_string(spacing) + " m (room for " +
-                                              std::to_string(pos.size()) + ")");
-    radii = draw_radii(dist, int(pos.size()), rng);
+    const std::string arrangement = rd.choice(f, fp, "arrangement", "lattice", {"lattice", "random"});
+    if (arrangement == "lattice") {
+      if (f["gap"]) rd.fail(Reader::join(fp, "gap"), "applies to arrangement: random only");
+      const double spacing = rd.number(f, fp, "spacing", 2.1 * dist.max(), 2 * dist.max(), kInf);
+      const double jitter = rd.number(f, fp, "jitter", 0.05 * (spacing - 2 * dist.max()) + 0.01 * dist.mean, 0,
+                                      0.5 * spacing);
+      pos = lattice_sites(region, spacing, dist.max(), jitter, int(count), rng);
+      if (long(pos.size()) < count)
+        rd.fail(Reader::join(fp, "count"), std::to_string(count) + " grains do not fit in the region at spacing " +
+                                                std::to_string(spacing) + " m (room for " +
+                                                std::to_string(pos.size()) + ")");
+      radii = draw_radii(dist, int(pos.size()), rng);
+    } else {
+      // Random sequential addition (docs/scenes.md E.1): radii first, then
+      // each grain at a uniform position clear of the earlier ones by `gap`.
+      for (const char* k : {"spacing", "jitter"})
+        if (f[k]) rd.fail(Reader::join(fp, k), "applies to arrangement: lattice only");
+      const double gap = rd.number(f, fp, "gap", 0.1 * dist.mean, 0, kInf);
+      const std::vector<double> drawn = draw_radii(dist, int(count), rng);
+      RandomFill fill = random_sites(region, drawn, 0.0, gap, 20000, rng);
+      if (long(fill.sites.size()) < count)
+        rd.fail(Reader::join(fp, "count"), std::to_string(count) +
+                                                " grains do not fit at random in the region (room found for " +
+                                                std::to_string(fill.sites.size()) +
+                                                " in 20000 draws each): make the region larger");
+      pos = std::move(fill.sites);
+      radii = std::move(fill.radii);
+    }
   } else {
     std::string file = rd.text(g, path, "file", "");
     // A relative path is taken from the scenario file's folder.
@@ -681,7 +700,7 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source) {
       const std::string p = "stages[" + std::to_string(i) + "]";
       rd.only(st[i], p,
               {"name", "duration", "hold", "remove_walls", "until_rms_speed", "until_max_speed", "check_every",
-               "gravity", "gravity_ramp", "trim_above", "stiffness_scale", "max_injection", "quench_every", "minimize", "release_springs"});
+               "gravity", "gravity_ramp", "trim_above", "trim_tops", "stiffness_scale", "max_injection", "quench_every", "minimize", "release_springs"});
       Stage s;
       s.name = rd.text(st[i], p, "name", "stage" + std::to_string(i));
       s.duration = rd.number(st[i], p, "duration", 0, 0, 1e9, true);
@@ -721,6 +740,8 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source) {
       s.quench_every = rd.number(st[i], p, "quench_every", 0, 0, kInf);
       s.minimize = rd.boolean(st[i], p, "minimize", false);
       s.release_springs = rd.boolean(st[i], p, "release_springs", false);
+      s.trim_tops = rd.boolean(st[i], p, "trim_tops", false);
+      if (st[i]["trim_tops"] && !st[i]["trim_above"]) rd.fail(p + ".trim_tops", "needs a 'trim_above' height");
       if (st[i]["trim_above"]) {
         s.trim = true;
         s.trim_above = rd.number(st[i], p, "trim_above", 0, -kInf, kInf);

@@ -1,5 +1,6 @@
-// Grain generation: truncated Gaussian radii and loose lattice fills of a box
-// or a cylinder, all driven by an explicit seed.
+// Grain generation: truncated Gaussian radii, loose lattice fills and random
+// (non-overlapping, uniformly placed) fills of a box or a cylinder, all driven
+// by an explicit seed.
 #pragma once
 
 #include <cstdint>
@@ -35,5 +36,19 @@ struct Region {
 // max_count sites.
 std::vector<Vec3> lattice_sites(const Region& r, double spacing, double margin, double jitter, int max_count,
                                 std::mt19937_64& rng);
+
+// Random sequential addition: each grain of `radii`, in order, is put at a
+// position uniform over the region (its whole sphere inside, with `margin`
+// more from the sides) that keeps it at least `gap` from every grain placed
+// before; up to `attempts` draws per grain. Returns the sites sorted
+// bottom-up in layers of 2 r_max, then by y and x (neighbours stay close in
+// memory), with the radii permuted alongside; fewer sites than radii when a
+// grain found no room (the region is too full).
+struct RandomFill {
+  std::vector<Vec3> sites;
+  std::vector<double> radii;
+};
+RandomFill random_sites(const Region& r, const std::vector<double>& radii, double margin, double gap, int attempts,
+                        std::mt19937_64& rng);
 
 }  // namespace rt

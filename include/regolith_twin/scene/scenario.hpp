@@ -49,6 +49,7 @@ struct Stage {
                                       //   the overlaps of a higher gravity while it is lowered
   bool trim = false;                  // remove grains at the start of the stage
   double trim_above = 0;              // ... whose centre lies above this height (z), m
+  bool trim_tops = false;             // ... or, when set, whose top (z + r) lies above it
 };
 
 struct Scenario {

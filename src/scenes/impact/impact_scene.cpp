@@ -32,9 +32,14 @@ ImpactSpec parse_impact(const YAML::Node& n, const std::string& src) {
   const YamlReader rd(src);
   const std::string p = "impact";
   if (!n || !n.IsMap()) rd.fail(p, "missing or not a mapping");
-  rd.only(n, p, {"impactor", "speed", "gap", "duration", "rest_speed", "rest_time", "fit_every", "sample_every"});
+  rd.only(n, p, {"impactor", "speed", "aim", "gap", "duration", "rest_speed", "rest_time", "fit_every", "sample_every"});
   sp.impactor = rd.text(n, p, "impactor", sp.impactor);
   sp.speed = rd.number(n, p, "speed", sp.speed, 0, 100, true);
+  if (n["aim"]) {
+    const YAML::Node a = n["aim"];
+    if (!a.IsSequence() || a.size() != 2) rd.fail(p + ".aim", "expected [x, y] in m");
+    sp.aim = Vec3(rd.number(a[0], p + ".aim[0]", -kInf, kInf), rd.number(a[1], p + ".aim[1]", -kInf, kInf), 0);
+  }
   sp.gap = rd.number(n, p, "gap", sp.gap, 0, 1);
   sp.duration = rd.number(n, p, "duration", sp.duration, 0, 1e4, true);
   sp.rest_speed = rd.number(n, p, "rest_speed", sp.rest_speed, 0, 10, true);
@@ -59,6 +64,7 @@ bool ImpactTracker::after_step(Model& m, State& s) {
   const double v = b.vel.z(), bottom = b.pos.z() - radius_;
   const double a = b.force.z() / mass_ - g_;  // contact force of the step, and gravity
   min_bottom_ = std::min(min_bottom_, bottom);
+  rebound_ = std::max(rebound_, bottom - min_bottom_);  // a rise above the lowest point reached so far
   if (t_contact_ < 0 && b.force.squaredNorm() > 0) {
     t_contact_ = s.time;
     fit_t0_ = s.time;
@@ -127,7 +133,9 @@ void ImpactTracker::summary(JsonObject& out) const {
   JsonObject o;
   o.num("stopping_depth", stopping_depth()).num("contact_at", t_contact_);
   o.num("duration_1cm_s", duration_1cm()).num("duration_1mm_s", duration_1mm());
-  o.boolean("bounced", bounced()).num("max_upward_speed", max_up_);
+  o.num("stopping_depth_mean_top", stopping_depth_mean_top());
+  o.boolean("bounced", bounced()).num("rebound", rebound_).boolean("bounced_1mm_s", bounced_1mm_s());
+  o.num("max_upward_speed", max_up_);
   o.num("f0", f0_).num("inv_d1", inv_d1_).num("fit_rms", fit_rms_).num("fit_samples", double(fit_v_.size()));
   out.obj("impact", o);
 }
@@ -141,8 +149,8 @@ std::string ImpactTracker::progress(const Model& m, const State& s) const {
 
 void ImpactTracker::write_csv(const std::string& path) const {
   std::ostringstream f;
-  f << "# t (s), depth of the sphere's bottom below the initial surface (m), v_z (m/s), a_z (m/s^2; contact "
-       "force / m - g), every 0.1 ms\n";
+  f << "# t (s), depth of the sphere's bottom below the bed's nominal surface (m), v_z (m/s), a_z (m/s^2; "
+       "contact force / m - g), every 0.1 ms\n";
   f << "t,depth,vz,az\n";
   f.precision(9);
   for (const Row& r : rows_) f << r.t << ',' << -r.depth << ',' << r.v << ',' << r.a << '\n';
@@ -152,7 +160,9 @@ void ImpactTracker::write_csv(const std::string& path) const {
 // --- one run ------------------------------------------------------------------------
 
 ImpactRun::ImpactRun(const ImpactScene& sc, const Model& m)
-    : SceneRun("impact"), scene_(sc), tracker_(sc.body, sc.radius, sc.surface, m.gravity.norm(), sc.spec) {}
+    : SceneRun("impact"),
+      scene_(sc),
+      tracker_(sc.body, sc.radius, sc.surface, sc.mean_top, m.gravity.norm(), sc.spec) {}
 
 std::unique_ptr<SceneRun> ImpactScene::begin(Run& run) const { return std::make_unique<ImpactRun>(*this, run.model()); }
 
@@ -164,20 +174,24 @@ void ImpactRun::write_summary(const std::string& path, const Model& m, const Sta
   if (!rep.message.empty()) j.str("message", rep.message);
   JsonObject in;
   in.num("speed", sc.spec.speed).num("gap", sc.spec.gap).num("sphere_radius", sc.radius);
+  in.num("aim_x", sc.spec.aim.x()).num("aim_y", sc.spec.aim.y());
   in.num("sphere_mass", m.bodies[sc.body].mass).num("gravity", m.gravity.norm());
   const double h = sc.spec.speed * sc.spec.speed / (2 * m.gravity.norm());
   in.num("free_fall_height", h);
   j.obj("input", in);
   JsonObject bed;
   bed.num("grains", sc.bed_grains).num("grain_diameter", sc.grain_diameter).num("surface", sc.surface);
+  bed.num("mean_top", sc.mean_top);
   bed.num("mass", sc.bed_mass).num("bulk_density", sc.bulk_density).num("packing_fraction", sc.packing);
   bed.num("container_radius", sc.container_radius).num("first_touch", sc.first_touch).str("cache", sc.bed_cache);
   j.obj("bed", bed);
   JsonObject res;
   const ImpactTracker& t = tracker_;
   res.num("stopping_depth", t.stopping_depth()).num("total_drop_height", h + t.stopping_depth());
+  res.num("stopping_depth_mean_top", t.stopping_depth_mean_top());
   res.num("duration_1cm_s", t.duration_1cm()).num("duration_1mm_s", t.duration_1mm());
-  res.boolean("bounced", t.bounced()).num("f0", t.f0()).num("inv_d1", t.inv_d1());
+  res.boolean("bounced", t.bounced()).num("rebound", t.rebound()).boolean("bounced_1mm_s", t.bounced_1mm_s());
+  res.num("f0", t.f0()).num("inv_d1", t.inv_d1());
   j.obj("result", res);
   add_run_and_observers(j, m, rep, threads);
   j.write(path);
@@ -254,12 +268,20 @@ std::unique_ptr<Scene> ImpactKind::prepare(const YAML::Node& doc, const std::str
   double top = 0;
   for (int k = 0; k < layer; ++k) top += tops[k];
   top /= layer;
+  is->mean_top = top;
+  // The nominal surface H: the height of the last cut, at the beads' tops
+  // (trim_tops), or its centre plane plus the largest radius; without a cut,
+  // the mean top.
   is->surface = top;
+  double r_max = 0;
+  for (int i = 0; i < m.n_grains; ++i) r_max = std::max(r_max, m.grain_radius[i]);
+  for (const Stage& st : sc.stages)
+    if (st.trim) is->surface = st.trim_above + (st.trim_tops ? 0.0 : r_max);
   is->grain_diameter = d;
   is->bed_grains = m.n_grains;
   is->bed_mass = mass;
-  is->bulk_density = mass / (area * top);
-  is->packing = vol / (area * top);
+  is->bulk_density = mass / (area * is->surface);
+  is->packing = vol / (area * is->surface);
 
   // 3. The sphere on the axis, its bottom `gap` above the height at which it
   // would first touch a bead (first touch: a bead at a distance rho from the
@@ -269,7 +291,7 @@ std::unique_ptr<Scene> ImpactKind::prepare(const YAML::Node& doc, const std::str
   double touch = -kInf;
   for (int i = 0; i < m.n_grains; ++i) {
     const double reach = is->radius + m.grain_radius[i];
-    const double rho = std::hypot(s.pos[i].x(), s.pos[i].y());
+    const double rho = std::hypot(s.pos[i].x() - sp.aim.x(), s.pos[i].y() - sp.aim.y());
     if (rho < reach) touch = std::max(touch, s.pos[i].z() + std::sqrt(reach * reach - rho * rho) - is->radius);
   }
   if (touch == -kInf) touch = top;
@@ -279,14 +301,17 @@ std::unique_ptr<Scene> ImpactKind::prepare(const YAML::Node& doc, const std::str
   const double v0 = std::sqrt(sp.speed * sp.speed - 2 * g * sp.gap);
   BodyState& b = s.bodies[is->body];
   b.q = bm.ref_rot.normalized();
-  b.pos = Vec3(0, 0, touch + sp.gap + is->radius);
+  if (std::hypot(sp.aim.x(), sp.aim.y()) + is->radius >= is->container_radius)
+    rd.fail("impact.aim", "the sphere must fit inside the container (" + std::to_string(is->container_radius) +
+                              " m radius) on that vertical");
+  b.pos = Vec3(sp.aim.x(), sp.aim.y(), touch + sp.gap + is->radius);
   set_body_velocity(bm, b, Vec3(0, 0, -v0), Vec3::Zero());
   restart_at_zero(s);
   if (!opt.quiet)
     std::fprintf(stderr,
-                 "[impact] bed: %d grains of %.3g mm, surface %.4g m, bulk %.0f kg/m^3 (packing %.3f); sphere %.3g kg, "
-                 "radius %.3g m, %.3g m/s at the surface\n",
-                 m.n_grains, d * 1e3, top, is->bulk_density, is->packing, bm.mass, is->radius, sp.speed);
+                 "[impact] bed: %d grains of %.3g mm, surface %.4g m (mean top %.4g m), bulk %.0f kg/m^3 (packing "
+                 "%.3f); sphere %.3g kg, radius %.3g m, %.3g m/s at the surface\n",
+                 m.n_grains, d * 1e3, is->surface, top, is->bulk_density, is->packing, bm.mass, is->radius, sp.speed);
   is->start = std::move(s);
   is->plan = RunPlan::open_ended(sc.name, "impact");
   is->plan.stages[0].duration = sp.duration;

@@ -28,7 +28,7 @@ TEST(ImpactTracker, FitRecoversTheForceLaw) {
   s.bodies[0].pos = Vec3(0, 0, r);  // bottom at the surface z = 0
   s.bodies[0].vel = Vec3(0, 0, -1.0);
   rt::ImpactSpec sp;
-  rt::ImpactTracker t(0, r, 0.0, g, sp);
+  rt::ImpactTracker t(0, r, 0.0, 0.0, g, sp);
   t.start(m, s);
   bool stopped = false;
   for (long k = 0; k < 2000000 && !stopped; ++k) {
@@ -56,6 +56,61 @@ TEST(ImpactTracker, FitRecoversTheForceLaw) {
   EXPECT_GT(t.duration_1mm(), t.duration_1cm());
 }
 
+// The sphere's bottom follows a prescribed path z(t) (the tracker reads the body state only).
+rt::ImpactTracker follow(const std::vector<std::pair<double, double>>& path, double dt) {
+  rt::Model m;
+  m.bodies.resize(1);
+  m.bodies[0].mass = 1.0;
+  rt::State s;
+  s.bodies.resize(1);
+  const double r = 0.05;
+  rt::ImpactSpec sp;
+  sp.rest_time = 10;  // never ends by itself
+  rt::ImpactTracker t(0, r, 0.0, 0.0, 9.81, sp);
+  s.bodies[0].pos = Vec3(0, 0, r + path.front().second);
+  t.start(m, s);
+  // Piecewise linear between the given (t, bottom) points.
+  for (size_t k = 1; k < path.size(); ++k) {
+    const double t0 = path[k - 1].first, t1 = path[k].first, z0 = path[k - 1].second, z1 = path[k].second;
+    const double v = (z1 - z0) / (t1 - t0);
+    for (double tt = t0 + dt; tt <= t1 + 1e-12; tt += dt) {
+      s.time = tt;
+      s.bodies[0].pos.z() = r + z0 + v * (tt - t0);
+      s.bodies[0].vel = Vec3(0, 0, v);
+      s.bodies[0].force = Vec3(0, 0, 1.0);  // in contact throughout
+      t.after_step(m, s);
+    }
+  }
+  return t;
+}
+
+TEST(ImpactTracker, BounceIsAReboundAfterTheDeepestPoint) {
+  // docs/scenes.md C.1: a rise of the bottom by more than 0.1 mm after its
+  // deepest point, or an upward speed above 1 cm/s.
+  const double dt = 1e-5;
+  // Down 10 mm, then a recoil of 50 um at 0.5 mm/s: no bounce by either definition.
+  rt::ImpactTracker a = follow({{0, 0}, {0.01, -0.01}, {0.11, -0.00995}}, dt);
+  EXPECT_FALSE(a.bounced());
+  EXPECT_FALSE(a.bounced_1mm_s());
+  EXPECT_NEAR(a.stopping_depth(), 0.01, 1e-12);
+  EXPECT_NEAR(a.rebound(), 5e-5, 1e-9);
+  // A recoil of 50 um at 2 mm/s: the variant's bounce (above 1 mm/s), not the published one.
+  rt::ImpactTracker b = follow({{0, 0}, {0.01, -0.01}, {0.035, -0.00995}}, dt);
+  EXPECT_FALSE(b.bounced());
+  EXPECT_TRUE(b.bounced_1mm_s());
+  // A slow rise of 0.2 mm (2 mm/s): a bounce.
+  rt::ImpactTracker c = follow({{0, 0}, {0.01, -0.01}, {0.11, -0.0098}}, dt);
+  EXPECT_TRUE(c.bounced());
+  // A rise of 0.2 mm, then deeper than before: still a bounce, the stopping depth the lowest point.
+  rt::ImpactTracker d = follow({{0, 0}, {0.01, -0.01}, {0.11, -0.0098}, {0.12, -0.012}, {0.22, -0.01195}}, dt);
+  EXPECT_TRUE(d.bounced());
+  EXPECT_NEAR(d.rebound(), 2e-4, 1e-9);
+  EXPECT_NEAR(d.stopping_depth(), 0.012, 1e-12);
+  // A fast flick upward of 10 um at 2 cm/s: a bounce by its speed.
+  rt::ImpactTracker e = follow({{0, 0}, {0.01, -0.01}, {0.0105, -0.00999}}, dt);
+  EXPECT_TRUE(e.bounced());
+}
+
 rt::SceneOptions quiet_options() {
   rt::SceneOptions o;
   o.cache_dir = ::testing::TempDir() + "/impact_cache";
@@ -81,14 +136,20 @@ TEST(ImpactScene, ASphereIntoASettledBed) {
       ASSERT_EQ(again->start.pos[i], sc.start.pos[i]);
     }
   }
-  EXPECT_GT(sc.surface, 0.035);
-  EXPECT_LT(sc.surface, 0.051);
-  EXPECT_GT(sc.packing, 0.45);
+  // The nominal surface: the cut's centre plane plus a bead radius; the mean top of the highest beads near it.
+  EXPECT_DOUBLE_EQ(sc.surface, 0.045 + 0.005);
+  EXPECT_GT(sc.mean_top, 0.035);
+  EXPECT_LT(sc.mean_top, 0.051);
+  // Packing: the beads' volume over the container's area times the nominal surface height.
+  double vol = 0;
+  for (int i = 0; i < m0.n_grains; ++i) vol += 4.0 / 3.0 * M_PI * std::pow(m0.grain_radius[i], 3);
+  EXPECT_NEAR(sc.packing, vol / (M_PI * 0.05 * 0.05 * 0.05), 1e-12);
+  EXPECT_GT(sc.packing, 0.40);
   EXPECT_LT(sc.packing, 0.66);
   // Placed on the axis, bottom `gap` above its first touch of a bead, reaching it at 0.5 m/s in free fall.
   const rt::BodyState& b = sc.start.bodies[sc.body];
-  EXPECT_GE(sc.first_touch, sc.surface);
-  EXPECT_LT(sc.first_touch, sc.surface + 0.01);
+  EXPECT_GE(sc.first_touch, sc.mean_top);
+  EXPECT_LT(sc.first_touch, sc.surface + 1e-9);
   EXPECT_NEAR(b.pos.z() - sc.radius - sc.first_touch, sc.spec.gap, 1e-12);
   // First touch: lowered by `gap`, the sphere touches one bead (curvature included) and overlaps none.
   double clearance = 1e9;
@@ -115,7 +176,28 @@ TEST(ImpactScene, ASphereIntoASettledBed) {
   EXPECT_LT(t.stopping_depth(), 0.045);  // ... above the bottom
   EXPECT_GT(t.duration_1cm(), 0);
   EXPECT_GE(t.duration_1mm(), t.duration_1cm());
-  EXPECT_EQ(t.bounced(), t.max_upward_speed() > 1e-3);
+  EXPECT_EQ(t.bounced_1mm_s(), t.max_upward_speed() > 1e-3);
+  EXPECT_NEAR(t.stopping_depth() - t.stopping_depth_mean_top(), sc.surface - sc.mean_top, 1e-12);
+}
+
+TEST(ImpactScene, CutByTopsAndAimedOffAxis) {
+  // trim_tops: every bead's top at or below the cut, which is the nominal surface;
+  // the sphere falls along the vertical through its aim point.
+  std::unique_ptr<rt::Scene> base = rt::load_scene(
+      kBucket, {"stages.1.trim_above=0.05", "stages.1.trim_tops=true", "impact.aim=[0.01,-0.005]"}, quiet_options());
+  auto& sc = static_cast<rt::ImpactScene&>(*base);
+  for (int i = 0; i < sc.sc.model.n_grains; ++i)
+    ASSERT_LE(sc.start.pos[i].z() + sc.sc.model.grain_radius[i], 0.05 + 1e-12);
+  EXPECT_DOUBLE_EQ(sc.surface, 0.05);
+  const rt::BodyState& b = sc.start.bodies[sc.body];
+  EXPECT_DOUBLE_EQ(b.pos.x(), 0.01);
+  EXPECT_DOUBLE_EQ(b.pos.y(), -0.005);
+  double clearance = 1e9;
+  for (int i = 0; i < sc.sc.model.n_grains; ++i) {
+    const rt::Vec3 c(0.01, -0.005, sc.first_touch + sc.radius);
+    clearance = std::min(clearance, (sc.start.pos[i] - c).norm() - sc.radius - sc.sc.model.grain_radius[i]);
+  }
+  EXPECT_NEAR(clearance, 0.0, 1e-12);
 }
 
 TEST(ImpactScene, BadInputIsRefused) {
@@ -130,6 +212,9 @@ TEST(ImpactScene, BadInputIsRefused) {
   refused({"impact.impactor=ball"}, "impact.impactor");
   refused({"impact.speed=0"}, "impact.speed");
   refused({"impact.spin=1"}, "spin");
+  refused({"impact.aim=[0.04,0]"}, "impact.aim");
+  refused({"impact.aim=[0.01]"}, "impact.aim");
+  refused({"stages.0.trim_tops=true"}, "trim_tops");
 }
 
 }  // namespace

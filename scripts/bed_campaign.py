@@ -1,0 +1,281 @@
+#!/usr/bin/python3
+"""Bed packing study (docs/validation.md "Beds"; docs/scenes.md E.1, F).
+
+  bed_campaign.py BIN OUT DOCS study [CASE...]   small beds: lattice against random fills, packing
+                                                  against the solid fraction of the generation region
+  bed_campaign.py BIN OUT DOCS prepare [BED...]  the shipped beds (config/beds/BED.bed), three seeds of
+                                                  the 30 cm MASCOT beds and of the sampler bed
+  bed_campaign.py BIN OUT DOCS report            DOCS/study.md, study.png and DOCS/prepared.md
+
+A small MASCOT-like bed (config/validation/bed_small.yaml: the MASCOT grains, walls and
+stiffness in a cylinder of 0.25 m radius, 5,000 grains) is poured under 1 g, either from the
+jittered lattice the shipped beds were generated on before, or from random positions in a
+cylinder whose height sets the solid fraction f of the generation region (the grains fall
+from higher the lower f is). Each run's packing is measured from its final grains and kept
+as DOCS/study/CASE/summary.json (committed: the study resumes on any machine; BEDS_RERUN=1 reruns).
+
+The shipped beds are generated the same way, at f = 0.12 (FILL_FRACTION) for every bed:
+config/beds/mascot_bed.yaml and config/beds/sampler_bed.yaml with the depth, material, seed,
+grain count and region height of each (BEDS). Each bed's figures (grains, packing, bulk
+density, rest check, wall time) are kept as DOCS/prepared/BED/summary.json, its snapshot as
+config/beds/BED.bed; the stages' snapshots stay in OUT/BED (restart points).
+BEDS_THREADS: threads per preparation (default 1).
+"""
+import json
+import math
+import os
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
+import campaign_cli  # noqa: E402
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+SMALL = os.path.join(ROOT, "config", "validation", "bed_small.yaml")
+R_SMALL = 0.25        # container radius of the small bed, m
+N_SMALL = 5000        # grains generated
+MEAN_VOLUME = None    # mean grain volume, m^3 (from the radius distribution; computed once)
+FRACTIONS = [0.06, 0.08, 0.10, 0.12, 0.15, 0.20]
+MATERIALS = ["gravel", "moderate"]
+SEEDS = [1, 2]
+H_TRIM = 0.15         # the trim height at which the small beds' counts are compared, m
+FILL_FRACTION = 0.12  # solid fraction of the generation region of every shipped bed
+# The pile is generated to stand about this much above the rim (at a packing of 0.55): two grain
+# diameters of the MASCOT beds, four of the sampler's, m.
+MARGIN = {"mascot": 0.04, "sampler": 0.02}
+MASCOT_R = 0.75       # MASCOT container radius, m
+SAMPLER_R = 0.15      # sampler container radius, m
+# Published grain counts (docs/scenes.md A.3, B.5).
+PUBLISHED = {"mascot_gravel_d15": 28375, "mascot_gravel_d30": 58454, "mascot_gravel_d40": 78176,
+             "mascot_moderate_d15": 31082, "mascot_moderate_d30": 62551, "mascot_moderate_d40": 83097,
+             "sampler_gravel": 101657}
+CORE_WALL = 0.05      # the core region keeps this far from the side wall, m
+CORE_FLOOR = 0.03     # ... from the floor and from the pile's top, m
+
+
+def grain_volume(mean, sigma):
+    """Mean volume of a grain of radius mean (1 + sigma z), z standard normal cut at +-1."""
+    n, acc, w = 4000, 0.0, 0.0
+    for k in range(n):
+        z = -1 + (k + 0.5) * 2 / n
+        p = math.exp(-z * z / 2)
+        acc += p * (4 / 3) * math.pi * (mean * (1 + sigma * z)) ** 3
+        w += p
+    return acc / w
+
+
+def mean_volume():
+    """Mean volume of a MASCOT grain (1 cm, sigma 33 %)."""
+    global MEAN_VOLUME
+    if MEAN_VOLUME is None:
+        MEAN_VOLUME = grain_volume(0.01, 0.33)
+    return MEAN_VOLUME
+
+
+def fill(radius, depth, margin, v_mean):
+    """(count, region top) of a bed of this depth in a cylinder of this radius: enough grains for a
+    pile `margin` above the rim at a packing of 0.55, generated at the solid fraction FILL_FRACTION."""
+    area = math.pi * radius ** 2
+    count = int(round(area * (depth + margin) * 0.55 / v_mean, -3))
+    return count, count * v_mean / (area * FILL_FRACTION)
+
+
+def beds():
+    """name -> (config, overrides, snapshot precision, published count or None, container radius, rim)."""
+    out = {}
+    for mat in MATERIALS:
+        for cm in (15, 30, 40):
+            for seed in ((1, 2, 3) if cm == 30 else (1,)):
+                name = "mascot_%s_d%d%s" % (mat, cm, "" if seed == 1 else "_s%d" % seed)
+                count, top = fill(MASCOT_R, cm / 100, MARGIN["mascot"], mean_volume())
+                ov = ["materials.regolith.preset=%s" % mat, "materials.container.preset=%s" % mat,
+                      "seed=%d" % (2018 + seed - 1), "grains.0.fill.count=%d" % count,
+                      "grains.0.fill.z=[0.0,%.4f]" % top, "stages.1.trim_above=%.2f" % (cm / 100)]
+                out[name] = ("mascot_bed.yaml", ov, "32", PUBLISHED["mascot_%s_d%d" % (mat, cm)], MASCOT_R,
+                             cm / 100)
+    for seed in (1, 2, 3):
+        name = "sampler_gravel%s" % ("" if seed == 1 else "_s%d" % seed)
+        count, top = fill(SAMPLER_R, 0.20, MARGIN["sampler"], grain_volume(0.0025, 0.30))
+        ov = ["seed=%d" % (2019 + seed - 1), "grains.0.fill.count=%d" % count, "grains.0.fill.z=[0.0,%.4f]" % top]
+        out[name] = ("sampler_bed.yaml", ov, "64", PUBLISHED["sampler_gravel"], SAMPLER_R, 0.20)
+    return out
+
+
+def bed_figures(grains_file, radius, rim, density=2430.0):
+    """Grains, packing fraction and bulk density of a prepared bed (grains with their centre at or below
+    the rim, over the cylinder up to the rim), and the highest grain top above the rim."""
+    rows = [list(map(float, ln.split()))[1:5] for ln in open(grains_file) if not ln.startswith("#")]
+    vol = sum((4 / 3) * math.pi * r ** 3 for _, _, z, r in rows if z <= rim)
+    packing = vol / (math.pi * radius ** 2 * rim)
+    return {"grains": len(rows), "packing": packing, "bulk_density": packing * density,
+            "highest_top_above_rim": max(z + r for _, _, z, r in rows) - rim}
+
+
+def prepare(bin_dir, out, docs, names):
+    known = beds()
+    campaign_cli.check_names(names, known, "bed")
+    threads = int(os.environ.get("BEDS_THREADS", "1"))
+    for name in names or list(known):
+        keep = os.path.join(docs, "prepared", name)
+        if campaign_cli.kept(keep, "BEDS_RERUN") is not None:
+            continue
+        config, overrides, precision, published, radius, rim = known[name]
+        snapshot = os.path.join(ROOT, "config", "beds", name + ".bed")
+        run_dir = os.path.join(out, name)
+        extra = ["--snapshot", snapshot, "--snapshot-precision", precision, "--stage-snapshots"]
+        s = campaign_cli.run_and_keep(bin_dir, os.path.join(ROOT, "config", "beds", config), run_dir, keep,
+                                      overrides, {"bed": name, "published_grains": published}, threads=threads,
+                                      extra=extra)
+        if s is None:
+            continue
+        fig = bed_figures(os.path.join(run_dir, "final_grains.txt"), radius, rim)
+        fig["snapshot_bytes"] = os.path.getsize(snapshot)
+        fig["published_grains"] = published
+        fig["difference"] = fig["grains"] / published - 1 if published else None
+        s["bed"] = fig
+        with open(os.path.join(keep, "summary.json"), "w") as f:
+            json.dump(s, f, indent=1)
+        print("%s: %d grains (published %s, %+.1f %%), packing %.4f, %.0f kg/m^3 (%.0f s)" % (
+            name, fig["grains"], published, 100 * (fig["difference"] or 0), fig["packing"], fig["bulk_density"],
+            s["campaign"]["wall_seconds"]), flush=True)
+
+
+def cases():
+    """name -> (material, overrides)."""
+    out = {}
+    for mat in MATERIALS:
+        mo = ["materials.regolith.preset=%s" % mat, "materials.container.preset=%s" % mat]
+        out["lattice_%s" % mat] = (mat, mo + ["grains.0.fill.arrangement=lattice"])
+        # A control: the lattice spread out (4 cm apart) with a jitter as large as the room allows,
+        # so that grains of a column no longer stand on each other.
+        out["lattice_wide_%s" % mat] = (mat, mo + ["grains.0.fill.arrangement=lattice", "grains.0.fill.spacing=0.04",
+                                                   "grains.0.fill.jitter=0.0067", "grains.0.fill.z=[0.0,2.0]"])
+        for f in FRACTIONS:
+            top = N_SMALL * mean_volume() / (math.pi * R_SMALL ** 2 * f)
+            for seed in SEEDS:
+                out["random_%s_f%.2f_s%d" % (mat, f, seed)] = (
+                    mat, mo + ["grains.0.fill.z=[0.0,%.4f]" % top, "seed=%d" % seed])
+    return out
+
+
+def cap_volume(r, h):
+    """Volume of a sphere of radius r below a plane h above its centre (h in [-r, r])."""
+    h = max(-r, min(r, h))
+    a = r + h
+    return math.pi * a * a * (3 * r - a) / 3
+
+
+def packing(grains_file):
+    """Packing figures of a settled small bed from its final_grains.txt."""
+    rows = [list(map(float, ln.split()))[1:5] for ln in open(grains_file) if not ln.startswith("#")]
+    tops = sorted(z + r for _, _, z, r in rows)
+    top = sum(tops[-50:]) / 50  # the pile's top: the mean top of its 50 highest grains
+    zlo, zhi = CORE_FLOOR, min(H_TRIM, top) - CORE_FLOOR
+    rin = R_SMALL - CORE_WALL
+    vol = 0.0
+    for x, y, z, r in rows:
+        if math.hypot(x, y) < rin:
+            vol += cap_volume(r, zhi - z) - cap_volume(r, zlo - z)
+    core = vol / (math.pi * rin * rin * (zhi - zlo))
+    n_centre = sum(1 for _, _, z, _ in rows if z <= H_TRIM)
+    n_top = sum(1 for _, _, z, r in rows if z + r <= H_TRIM)
+    return {"core_packing": core, "top": top, "n_centre": n_centre, "n_top": n_top,
+            "packing_centre_trim": sum((4 / 3) * math.pi * r ** 3 for _, _, z, r in rows if z <= H_TRIM)
+            / (math.pi * R_SMALL ** 2 * H_TRIM)}
+
+
+def study(bin_dir, out, docs, names):
+    known = cases()
+    campaign_cli.check_names(names, known, "case")
+    keep_root = os.path.join(docs, "study")
+    for name in names or list(known):
+        keep = os.path.join(keep_root, name)
+        if campaign_cli.kept(keep, "BEDS_RERUN") is not None:
+            continue
+        mat, overrides = known[name]
+        run_dir = os.path.join(out, name)
+        s = campaign_cli.run_and_keep(bin_dir, SMALL, run_dir, keep, overrides, {"case": name, "material": mat})
+        if s is None:
+            continue
+        p = packing(os.path.join(run_dir, "final_grains.txt"))
+        s["packing"] = p
+        with open(os.path.join(keep, "summary.json"), "w") as f:
+            json.dump(s, f, indent=1)
+        print("%s: core packing %.4f, %d grains below %.2f m by centre, %d by top (%.0f s)" % (
+            name, p["core_packing"], p["n_centre"], H_TRIM, p["n_top"], s["campaign"]["wall_seconds"]), flush=True)
+
+
+def load(docs):
+    out = {}
+    root = os.path.join(docs, "study")
+    for name in sorted(os.listdir(root)) if os.path.isdir(root) else []:
+        f = os.path.join(root, name, "summary.json")
+        if os.path.exists(f):
+            out[name] = json.load(open(f))
+    return out
+
+
+def report(docs):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    runs = load(docs)
+    lines = ["# Bed packing study", "",
+             "Generated by `scripts/validate_beds study` (`scripts/bed_campaign.py`) from the runs in "
+             "`study/`. A small MASCOT-like bed (`config/validation/bed_small.yaml`: 5,000 grains of 1 cm "
+             "mean radius, σ 33 %%, in a cylinder of %.2f m radius, the MASCOT walls and k_n) is poured "
+             "under 1 g until its RMS speed is below 5 mm/s. **Core packing**: the solid fraction of the "
+             "grains' volume (exact sphere caps) between %.2f m above the floor and %.2f m below the "
+             "pile's top or the %.2f m trim height, within %.2f m of the axis (%.2f m from the wall). "
+             "**Counts**: grains whose centre, or whose top, is at or below %.2f m. "
+             "f: the solid fraction of the random generation region (its height is N ⟨V⟩ / (π R² f)); "
+             "the lattice is the jittered simple cubic fill the beds were generated on before." % (
+                 R_SMALL, CORE_FLOOR, CORE_FLOOR, H_TRIM, R_SMALL - CORE_WALL, CORE_WALL, H_TRIM), "",
+             "| case | material | fill | f | seed | core packing | grains by centre | by top | wall (s) |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    fig, ax = plt.subplots(1, 1, figsize=(6, 4))
+    for mat, color in zip(MATERIALS, ("C0", "C1")):
+        xs, ys = [], []
+        for name, s in runs.items():
+            if s["campaign"]["material"] != mat or not name.startswith("random"):
+                continue
+            f = float(name.split("_f")[1].split("_")[0])
+            xs.append(f)
+            ys.append(s["packing"]["core_packing"])
+        if xs:
+            ax.plot(xs, ys, "o", color=color, label="%s, random fill" % mat)
+        lat = runs.get("lattice_%s" % mat)
+        if lat:
+            ax.axhline(lat["packing"]["core_packing"], color=color, ls="--", lw=1, label="%s, lattice fill" % mat)
+    for name, s in runs.items():
+        p = s["packing"]
+        if name.startswith("random"):
+            f, seed = name.split("_f")[1].split("_s")
+            fill = "random"
+        else:
+            f, seed = "–", "–"
+            fill = "lattice 4 cm, jitter ±6.7 mm" if name.startswith("lattice_wide") else "lattice"
+        lines.append("| `%s` | %s | %s | %s | %s | %.4f | %d | %d | %.0f |" % (
+            name, s["campaign"]["material"], fill, f, seed, p["core_packing"], p["n_centre"], p["n_top"],
+            s["campaign"]["wall_seconds"]))
+    ax.set_xlabel("solid fraction f of the generation region")
+    ax.set_ylabel("core packing fraction after the 1 g pour")
+    ax.set_title("Small bed (R = 0.25 m, 5,000 grains)", fontsize=9)
+    lines += campaign_cli.failure_lines(os.path.join(docs, "study"))
+    path = campaign_cli.write_report(docs, lines, fig, [ax], "study.png", "core packing against f", name="study.md")
+    print("report: %s" % path)
+
+
+def main():
+    bin_dir, out, docs, cmd, names = campaign_cli.command_line(__doc__)
+    if cmd == "study":
+        study(bin_dir, out, docs, names)
+    elif cmd == "prepare":
+        prepare(bin_dir, out, docs, names)
+    elif cmd == "report":
+        report(docs)
+    else:
+        raise SystemExit(__doc__)
+
+
+if __name__ == "__main__":
+    main()

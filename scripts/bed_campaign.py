@@ -14,7 +14,7 @@ cylinder whose height sets the solid fraction f of the generation region (the gr
 from higher the lower f is). Each run's packing is measured from its final grains and kept
 as DOCS/study/CASE/summary.json (committed: the study resumes on any machine; BEDS_RERUN=1 reruns).
 
-The shipped beds are generated the same way, at f = 0.12 (FILL_FRACTION) for every bed:
+The shipped beds are generated the same way, at f = 0.15 (FILL_FRACTION) for every bed:
 config/beds/mascot_bed.yaml and config/beds/sampler_bed.yaml with the depth, material, seed,
 grain count and region height of each (BEDS). Each bed's figures (grains, packing, bulk
 density, rest check, wall time) are kept as DOCS/prepared/BED/summary.json, its snapshot as
@@ -38,7 +38,7 @@ FRACTIONS = [0.06, 0.08, 0.10, 0.12, 0.15, 0.20]
 MATERIALS = ["gravel", "moderate"]
 SEEDS = [1, 2]
 H_TRIM = 0.15         # the trim height at which the small beds' counts are compared, m
-FILL_FRACTION = 0.12  # solid fraction of the generation region of every shipped bed
+FILL_FRACTION = 0.15  # solid fraction of the generation region of every shipped bed
 # The pile is generated to stand about this much above the rim (at a packing of 0.55): two grain
 # diameters of the MASCOT beds, four of the sampler's, m.
 MARGIN = {"mascot": 0.04, "sampler": 0.02}

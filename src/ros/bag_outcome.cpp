@@ -108,15 +108,7 @@ int main(int argc, char** argv) {
     tracker.finish(t);
     const rt::LandingOutcome& o = tracker.outcome();
     rt::JsonObject oc;
-    oc.boolean("contact", o.contact).boolean("lifted_off", o.lifted_off).str("ended_by", o.ended_by);
-    oc.num("cancelled_liftoffs", o.relandings);
-    oc.num("t_contact", o.t_contact).num("t_liftoff", o.t_liftoff).num("t_end", o.t_end);
-    oc.num("v_in", o.v_in).num("v_out", o.v_out).num("speed_ratio", o.speed_ratio);
-    oc.num("E_lin_in", o.e_lin_in).num("E_rot_in", o.e_rot_in).num("E_lin_out", o.e_lin_out).num("E_rot_out", o.e_rot_out);
-    oc.num("energy_ratio", o.energy_ratio).num("angle_out_deg", o.angle_out_deg).num("spin_out", o.spin_out);
-    oc.num("collision_duration", o.collision_duration).num("max_penetration", o.max_penetration);
-    oc.num("h_liftoff", o.h_liftoff).num("travel_distance", o.travel_distance).num("travel_time", o.travel_time);
-    oc.num("second_impact_speed", o.second_impact_speed).num("second_impact_angle_deg", o.second_impact_angle_deg);
+    rt::landing_outcome_json(o, oc);
     rt::JsonObject j;
     j.str("bag", bag_path).str("file", file).str("body", body).num("messages", double(messages));
     j.obj("outcome", oc);

@@ -38,8 +38,10 @@ class RecordReplay(unittest.TestCase):
         self.assertGreaterEqual(rep["messages"], run["run"]["steps"], "the recording misses steps of the landing")
         a, b = run["outcome"], rep["outcome"]
         self.assertTrue(a["contact"] and a["lifted_off"], "the test landing must touch down and lift off")
-        for key in ("contact", "lifted_off", "ended_by", "cancelled_liftoffs"):
+        for key in ("contact", "lifted_off", "ended_by"):
             self.assertEqual(a[key], b[key], key)
+        for key in ("lifted_off", "cancelled_liftoffs"):
+            self.assertEqual(a["clear_liftoff"][key], b["clear_liftoff"][key], "clear_liftoff." + key)
         # Times travel as ROS stamps (1 ns); the rest through the pose and twist messages.
         for key in ("t_contact", "t_liftoff", "collision_duration"):
             self.assertAlmostEqual(a[key], b[key], delta=2e-9, msg=key)
@@ -50,6 +52,11 @@ class RecordReplay(unittest.TestCase):
                     "angle_out_deg", "spin_out", "max_penetration", "h_liftoff", "travel_distance",
                     "travel_time", "second_impact_speed", "second_impact_angle_deg"):
             self.assertAlmostEqual(a[key], b[key], delta=1e-9 * max(1.0, abs(a[key])), msg=key)
+        for key in ("t_liftoff", "collision_duration"):
+            self.assertAlmostEqual(a["clear_liftoff"][key], b["clear_liftoff"][key], delta=2e-9, msg=key)
+        for key in ("v_out", "speed_ratio", "travel_distance"):
+            self.assertAlmostEqual(a["clear_liftoff"][key], b["clear_liftoff"][key],
+                                   delta=1e-9 * max(1.0, abs(a["clear_liftoff"][key])), msg="clear_liftoff." + key)
 
 
 if __name__ == "__main__":

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/run/bed_cache.hpp"
 #include "regolith_twin/run/series.hpp"
 #include "regolith_twin/scene/yaml_reader.hpp"
@@ -32,8 +33,10 @@ InclineSpec parse_incline(const YAML::Node& n, const std::string& src) {
   rd.only(n, p, {"mode", "angle_deg", "start_deg", "step_deg", "max_deg", "hold", "flow_speed", "duration", "average",
                  "layer", "sample_every"});
   const std::string mode = rd.text(n, p, "mode", "steady");
-  if (mode != "steady" && mode != "onset") rd.fail(p + ".mode", "expected steady or onset, got '" + mode + "'");
+  if (mode != "steady" && mode != "onset" && mode != "rain")
+    rd.fail(p + ".mode", "expected steady, onset or rain, got '" + mode + "'");
   sp.onset = mode == "onset";
+  sp.rain = mode == "rain";
   sp.angle_deg = rd.number(n, p, "angle_deg", sp.angle_deg, 0, 89);
   sp.start_deg = rd.number(n, p, "start_deg", sp.start_deg, 0, 89);
   sp.step_deg = rd.number(n, p, "step_deg", sp.step_deg, 0, 10, true);
@@ -74,6 +77,24 @@ double bagnold_amplitude(const std::vector<double>& z, const std::vector<double>
 
 double bagnold_inertial_number(double a, double d, double h, double phi, double g, double theta) {
   return 3 * d * a / (2 * std::pow(h, 1.5) * std::sqrt(phi * g * std::cos(theta)));
+}
+
+double trend(const std::vector<double>& t, const std::vector<double>& v) {
+  const size_t n = t.size();
+  if (n < 2) return 0;
+  double mt = 0, mv = 0;
+  for (size_t k = 0; k < n; ++k) {
+    mt += t[k];
+    mv += v[k];
+  }
+  mt /= n;
+  mv /= n;
+  double stt = 0, stv = 0;
+  for (size_t k = 0; k < n; ++k) {
+    stt += (t[k] - mt) * (t[k] - mt);
+    stv += (t[k] - mt) * (v[k] - mv);
+  }
+  return stt > 0 ? stv / stt : 0;
 }
 
 bool onset_flowing(double v_end, double dvdt_end, double hold, double threshold) {
@@ -131,11 +152,27 @@ bool InclineObserver::after_step(Model& m, State& s) {
     marked_ = false;
     return false;
   }
-  // Steady: sample the layers every sample interval over the last `average` s.
+  if (sp_.rain) {
+    // Every free grain that touches the plane is glued where it is (docs/scenes.md C.2).
+    bool glued = false;
+    for (int i = 0; i < m.n_grains; ++i)
+      if (m.grain_inv_mass[i] != 0 && s.pos[i].z() - m.grain_radius[i] < floor_) {
+        hold_grain(m, s, i);
+        ++glued_;
+        glued = true;
+      }
+    if (glued) s.rebuild_requested = true;  // pair constants (m*) and partitions follow
+  }
+  // Steady and rain: sample the layers every sample interval over the last `average` s.
   const double t_end = sp_.duration;
   if (s.time < t_end - sp_.average) return false;
   const long every = std::max(1L, std::lround(0.01 / m.dt));
   if (s.step % every != 0) return false;
+  if (sp_.rain) {
+    if (!window_started_) find_layers(m, s);
+    win_t_.push_back(s.time);
+    win_v_.push_back(mean_vx(m, s));
+  }
   for (int i = 0; i < m.n_grains; ++i) {
     if (m.grain_inv_mass[i] == 0) continue;
     const int k = int(std::floor((s.pos[i].z() - base_) / sp_.layer));
@@ -149,7 +186,33 @@ bool InclineObserver::after_step(Model& m, State& s) {
   return false;
 }
 
+void InclineObserver::find_layers(const Model& m, const State& s) {
+  // The base: the glued grains' highest top; the bed's top: the mean top of its highest A/d^2 free grains.
+  window_started_ = true;
+  double base = floor_;
+  std::vector<double> tops;
+  for (int i = 0; i < m.n_grains; ++i) {
+    if (m.grain_inv_mass[i] == 0) base = std::max(base, s.pos[i].z() + m.grain_radius[i]);
+    else tops.push_back(s.pos[i].z() + m.grain_radius[i]);
+  }
+  std::sort(tops.begin(), tops.end(), std::greater<double>());
+  const int layer = std::clamp(int(std::lround(area_ / (d_ * d_))), 1, std::max(1, int(tops.size())));
+  double top = 0;
+  for (int k = 0; k < layer && k < int(tops.size()); ++k) top += tops[k];
+  base_ = base;
+  top_ = tops.empty() ? base : top / std::min(layer, int(tops.size()));
+  const int layers = std::max(1, int(std::ceil((top_ - base_) / sp_.layer)) + 2);
+  sum_vx_.assign(layers, 0);
+  sum_vol_.assign(layers, 0);
+  count_.assign(layers, 0);
+}
+
 void InclineObserver::finish(Model& m, State& s) {
+  if (sp_.rain && !win_t_.empty()) {
+    end_vx_ = win_v_.back();
+    end_dvdt_ = trend(win_t_, win_v_);
+    flowing_ = onset_flowing(end_vx_, end_dvdt_, sp_.average, sp_.flow_speed * std::sqrt(g_ * d_));
+  }
   if (sp_.onset || samples_ == 0) return;
   Profile& p = prof_;
   p.height = top_ - base_;
@@ -184,7 +247,11 @@ void InclineObserver::row(const Model& m, const State& s, std::vector<double>& o
 
 void InclineObserver::summary(JsonObject& out) const {
   JsonObject o;
-  o.str("mode", sp_.onset ? "onset" : "steady").num("theta_deg", theta_deg_);
+  o.str("mode", sp_.onset ? "onset" : sp_.rain ? "rain" : "steady").num("theta_deg", theta_deg_);
+  if (sp_.rain) {
+    o.num("glued_grains", glued_).num("end_mean_vx", end_vx_).num("end_dvdt", end_dvdt_);
+    o.boolean("flowing", flowing_).num("base_top", base_).num("bed_top", top_);
+  }
   if (sp_.onset) {
     o.num("onset_deg", onset_deg_);
     std::vector<double> th, v, a;
@@ -226,7 +293,9 @@ void InclineObserver::write_csv(const std::string& dir) const {
 // --- one run ------------------------------------------------------------------------
 
 InclineRun::InclineRun(const InclineScene& sc, const Model& m)
-    : SceneRun("incline"), scene_(sc), obs_(sc.spec, sc.base_top, sc.top, sc.diameter, sc.area, m.gravity.norm()) {}
+    : SceneRun("incline"),
+      scene_(sc),
+      obs_(sc.spec, sc.base_top, sc.top, sc.diameter, sc.area, m.gravity.norm(), sc.floor_z) {}
 
 std::unique_ptr<SceneRun> InclineScene::begin(Run& run) const { return std::make_unique<InclineRun>(*this, run.model()); }
 
@@ -260,6 +329,13 @@ std::string InclineRun::result_line(const Model& m, const State& s, const RunRep
   if (scene_.spec.onset)
     std::snprintf(b, sizeof b, "incline %s: onset of flow at %.1f deg (%.0f s wall)", scene_.sc.name.c_str(),
                   o.onset_deg(), rep.wall_seconds);
+  else if (scene_.spec.rain)
+    std::snprintf(b, sizeof b,
+                  "incline %s: rained at %.1f deg: %s (mean v_x %.4g m/s, trend %.3g m/s^2; %d grains glued), "
+                  "Bagnold A = %.4g m/s, I = %.4g (%.0f s wall)",
+                  scene_.sc.name.c_str(), o.theta_deg(), o.flowing() ? "flowing" : "at rest or stopping",
+                  o.end_vx(), o.end_dvdt(), o.glued(), o.profile().bagnold_a, o.profile().inertial_number,
+                  rep.wall_seconds);
   else
     std::snprintf(b, sizeof b,
                   "incline %s: %.1f deg, Bagnold A = %.4g m/s over h = %.4g m, Phi = %.3f, I = %.4g (%.0f s wall)",
@@ -282,6 +358,34 @@ std::unique_ptr<Scene> InclineKind::prepare(const YAML::Node& doc, const std::st
   for (const auto& w : sc.warnings) std::fprintf(stderr, "[incline] warning: %s\n", w.c_str());
   if (!m.periodic.x || !m.periodic.y) rd.fail("periodic", "the incline scene needs a box periodic in x and y");
   if (m.n_grains == 0) rd.fail("grains", "the incline scene needs a bed");
+  if (is->spec.rain) {
+    // The published protocol: the generated grains rain onto the plane already tilted; no relaxation.
+    bool floor = false;
+    for (const Wall& w : m.walls)
+      if (w.type == WallType::Plane && w.axis.z() > 1 - 1e-9) {
+        is->floor_z = w.origin.z();
+        floor = true;
+      }
+    if (!floor) rd.fail("walls", "mode rain needs a plane floor (normal +z) to glue the first grains to");
+    for (int i = 0; i < m.n_grains; ++i)
+      if (m.grain_fixed[i]) rd.fail("grains", "mode rain forms its own base: no glued ('fixed') grains");
+    State s = sc.initial;
+    double d = 0;
+    for (int i = 0; i < m.n_grains; ++i) d += 2 * m.grain_radius[i];
+    is->grains = m.n_grains;
+    is->diameter = d / m.n_grains;
+    is->area = m.periodic.length.x() * m.periodic.length.y();
+    is->base_top = is->top = is->floor_z;
+    restart_at_zero(s);
+    if (!opt.quiet)
+      std::fprintf(stderr, "[incline] %d grains rained onto the plane tilted at %.1f deg\n", is->grains,
+                   is->spec.angle_deg);
+    is->start = std::move(s);
+    is->plan = RunPlan::open_ended(sc.name, "rain");
+    is->plan.stages[0].duration = is->spec.duration;
+    is->sample_every = is->spec.sample_every;
+    return is;
+  }
   RelaxedBed bed = relax_bed(sc, sc.initial, {}, opt, "incline");
   State s = std::move(bed.state);
   is->bed_cache = bed.cache;

@@ -212,7 +212,37 @@ double LandingTracker::lowest_corner(const BodyState& bs) const {
 }
 
 const char* LandingTracker::phase() const {
-  return !o_.contact ? "approach" : (!o_.lifted_off ? "collision" : "flight");
+  return !o_.contact ? "approach" : (!o_.lifted_off_clear ? "collision" : "flight");
+}
+
+Departure LandingTracker::depart(double t, const BodyState& bs) const {
+  Departure d;
+  d.t = t;
+  d.v_out = bs.vel.norm();
+  d.e_lin_out = body_lin_energy(bm_, bs);
+  d.e_rot_out = body_rot_energy(bm_, bs);
+  d.spin_out = bs.omega.norm();
+  d.angle_out_deg = std::acos(std::clamp(bs.vel.z() / std::max(d.v_out, 1e-300), -1.0, 1.0)) / kDeg;
+  d.h_liftoff = bs.pos.z() - sp_.rim;
+  // Ballistic flight under the (possibly tilted) gravity, heights normal to the trim plane.
+  const Vec3 v0 = bs.vel;
+  const double gn = g_.z(), vn = v0.z();
+  double ht = std::max(d.h_liftoff, sp_.sphere_radius);
+  double disc = vn * vn + 2 * gn * (ht - d.h_liftoff);
+  if (disc < 0) {  // apex below the sphere radius: back to the lift-off height instead
+    ht = d.h_liftoff;
+    disc = vn * vn;
+  }
+  if (gn < 0 && vn > 0) {
+    const double tf = (-vn - std::sqrt(disc)) / gn;
+    const Vec3 dx = v0 * tf + 0.5 * g_ * tf * tf;
+    d.travel_time = tf;
+    d.travel_distance = std::hypot(dx.x(), dx.y());
+    const Vec3 v1 = v0 + g_ * tf;
+    d.second_impact_speed = v1.norm();
+    d.second_impact_angle_deg = std::acos(std::min(1.0, std::fabs(v1.z()) / v1.norm())) / kDeg;
+  }
+  return d;
 }
 
 bool LandingTracker::update(double t, const BodyState& bs, const BodyContacts& c) {
@@ -226,52 +256,48 @@ bool LandingTracker::update(double t, const BodyState& bs, const BodyContacts& c
     o_.e_lin_in = body_lin_energy(bm_, bs);
     o_.e_rot_in = body_rot_energy(bm_, bs);
   }
-  if (o_.lifted_off && c.bed > 0) {
+  // Lift-off (published): once a corner has been below the trim plane, the first moment every corner is
+  // above it again (or the clear lift-off, below, if no corner ever went under: a bounce off a boulder).
+  if (o_.contact && low <= 0) went_under_ = true;
+  const bool clear_now = o_.contact && !o_.lifted_off_clear && low > 0 && !touching && bs.vel.z() > 0;
+  if (o_.contact && !o_.lifted_off && low > 0 && (went_under_ || clear_now)) {
+    o_.lifted_off = true;
+    const Departure d = depart(t, bs);
+    o_.t_liftoff = t;
+    o_.v_out = d.v_out;
+    o_.e_lin_out = d.e_lin_out;
+    o_.e_rot_out = d.e_rot_out;
+    o_.spin_out = d.spin_out;
+    o_.angle_out_deg = d.angle_out_deg;
+    o_.h_liftoff = d.h_liftoff;
+    o_.travel_distance = d.travel_distance;
+    o_.travel_time = d.travel_time;
+    o_.second_impact_speed = d.second_impact_speed;
+    o_.second_impact_angle_deg = d.second_impact_angle_deg;
+  }
+  if (o_.lifted_off_clear && c.bed > 0) {
     // Contact again within the after-lift-off window with the bed (a body,
     // or a grain that is not ejecta): the lander had not left; the collision
     // goes on (decision, documented in landing.hpp). Ejected grains drifting
     // with the lander do not count.
-    o_.lifted_off = false;
+    o_.lifted_off_clear = false;
     ++o_.relandings;
   }
-  if (o_.contact && !o_.lifted_off) {
+  if (o_.contact && !o_.lifted_off_clear) {
     o_.max_penetration = std::max(o_.max_penetration, -low);
-    // Lift-off: every corner above the trim plane, no contact, and the
+    // Clear lift-off: every corner above the trim plane, no contact, and the
     // centre of mass moving away from the surface.
-    if (low > 0 && !touching && bs.vel.z() > 0) {
-      o_.lifted_off = true;
-      o_.t_liftoff = t;
-      o_.v_out = bs.vel.norm();
-      o_.e_lin_out = body_lin_energy(bm_, bs);
-      o_.e_rot_out = body_rot_energy(bm_, bs);
-      o_.spin_out = bs.omega.norm();
-      o_.angle_out_deg = std::acos(std::clamp(bs.vel.z() / std::max(o_.v_out, 1e-300), -1.0, 1.0)) / kDeg;
-      o_.h_liftoff = bs.pos.z() - sp_.rim;
-      // Ballistic flight under the (possibly tilted) gravity, heights normal to the trim plane.
-      const Vec3 v0 = bs.vel;
-      const double gn = g_.z(), vn = v0.z();
-      double ht = std::max(o_.h_liftoff, sp_.sphere_radius);
-      double disc = vn * vn + 2 * gn * (ht - o_.h_liftoff);
-      if (disc < 0) {  // apex below the sphere radius: back to the lift-off height instead
-        ht = o_.h_liftoff;
-        disc = vn * vn;
-      }
-      if (gn < 0) {
-        const double tf = (-vn - std::sqrt(disc)) / gn;
-        const Vec3 d = v0 * tf + 0.5 * g_ * tf * tf;
-        o_.travel_time = tf;
-        o_.travel_distance = std::hypot(d.x(), d.y());
-        const Vec3 v1 = v0 + g_ * tf;
-        o_.second_impact_speed = v1.norm();
-        o_.second_impact_angle_deg = std::acos(std::min(1.0, std::fabs(v1.z()) / v1.norm())) / kDeg;
-      }
+    if (clear_now) {
+      o_.lifted_off_clear = true;
+      o_.t_liftoff_clear = t;
+      o_.clear = depart(t, bs);
     }
   }
-  if (o_.lifted_off && t >= o_.t_liftoff + sp_.after_liftoff) {
+  if (o_.lifted_off_clear && t >= o_.t_liftoff_clear + sp_.after_liftoff) {
     o_.ended_by = "after_liftoff";
-  } else if (o_.contact && !o_.lifted_off && sp_.trapped_hold > 0 && trapped(t, bs)) {
+  } else if (o_.contact && !o_.lifted_off_clear && sp_.trapped_hold > 0 && trapped(t, bs)) {
     o_.ended_by = "trapped";
-  } else if (o_.contact && !o_.lifted_off && t >= o_.t_contact + sp_.max_after_contact) {
+  } else if (o_.contact && !o_.lifted_off_clear && t >= o_.t_contact + sp_.max_after_contact) {
     o_.ended_by = "max_after_contact";
   } else if (!o_.contact && t - t_start_ >= sp_.max_time) {
     o_.ended_by = "max_time";
@@ -292,16 +318,39 @@ bool LandingTracker::trapped(double t, const BodyState& bs) {
 
 void LandingTracker::finish(double t) {
   if (!o_.lifted_off) o_.v_out = 0;
+  if (!o_.lifted_off_clear) o_.clear = Departure();
   o_.t_end = t;
   if (o_.contact) {
     o_.speed_ratio = o_.v_in > 0 ? o_.v_out / o_.v_in : 0;
     o_.collision_duration = (o_.lifted_off ? o_.t_liftoff : t) - o_.t_contact;
+    o_.speed_ratio_clear = o_.v_in > 0 ? o_.clear.v_out / o_.v_in : 0;
+    o_.collision_duration_clear = (o_.lifted_off_clear ? o_.t_liftoff_clear : t) - o_.t_contact;
     if (o_.e_lin_in > 0) {
       o_.rot_out_over_lin_in = o_.e_rot_out / o_.e_lin_in;
       o_.energy_ratio = (o_.e_lin_out + o_.e_rot_out) / (o_.e_lin_in + o_.e_rot_in);
     }
     if (o_.e_lin_out > 0) o_.rot_out_over_lin_out = o_.e_rot_out / o_.e_lin_out;
   }
+}
+
+void landing_outcome_json(const LandingOutcome& o, JsonObject& oc) {
+  oc.boolean("contact", o.contact).boolean("lifted_off", o.lifted_off).str("ended_by", o.ended_by);
+  oc.num("t_contact", o.t_contact).num("t_liftoff", o.t_liftoff).num("t_end", o.t_end);
+  oc.num("v_in", o.v_in).num("v_out", o.v_out).num("speed_ratio", o.speed_ratio);
+  oc.num("E_lin_in", o.e_lin_in).num("E_rot_in", o.e_rot_in).num("E_lin_out", o.e_lin_out).num("E_rot_out", o.e_rot_out);
+  oc.num("E_rot_out_over_E_lin_in", o.rot_out_over_lin_in).num("E_rot_out_over_E_lin_out", o.rot_out_over_lin_out);
+  oc.num("energy_ratio", o.energy_ratio).num("angle_out_deg", o.angle_out_deg).num("spin_out", o.spin_out);
+  oc.num("collision_duration", o.collision_duration).num("max_penetration", o.max_penetration);
+  oc.num("h_liftoff", o.h_liftoff).num("travel_distance", o.travel_distance).num("travel_time", o.travel_time);
+  oc.num("second_impact_speed", o.second_impact_speed).num("second_impact_angle_deg", o.second_impact_angle_deg);
+  // The clear lift-off (variant; it also ends the run).
+  JsonObject c;
+  c.boolean("lifted_off", o.lifted_off_clear).num("cancelled_liftoffs", o.relandings);
+  c.num("t_liftoff", o.t_liftoff_clear).num("v_out", o.clear.v_out).num("speed_ratio", o.speed_ratio_clear);
+  c.num("collision_duration", o.collision_duration_clear).num("angle_out_deg", o.clear.angle_out_deg);
+  c.num("spin_out", o.clear.spin_out).num("h_liftoff", o.clear.h_liftoff);
+  c.num("travel_distance", o.clear.travel_distance).num("travel_time", o.clear.travel_time);
+  oc.obj("clear_liftoff", c);
 }
 
 // --- the tracker as an observer ---------------------------------------------------
@@ -353,7 +402,8 @@ std::string LandingTrackerObserver::progress(const Model& m, const State& s) con
 double LandingTrackerObserver::time_left(const State& s) const {
   const LandingOutcome& o = tracker_->outcome();
   if (!o.contact) return -1;
-  return (!o.lifted_off ? o.t_contact + sp_.max_after_contact : o.t_liftoff + sp_.after_liftoff) - s.time;
+  return (!o.lifted_off_clear ? o.t_contact + sp_.max_after_contact : o.t_liftoff_clear + sp_.after_liftoff) -
+         s.time;
 }
 
 LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& sp, const LandingOptions& opt) {

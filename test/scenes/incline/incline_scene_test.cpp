@@ -133,4 +133,88 @@ TEST(InclineScene, AFlowingPeriodicBedWrapsWithoutTrippingTheEnergyGuard) {
   EXPECT_GT(wrapped, 0);
 }
 
+TEST(InclineRain, TrendIsTheLeastSquaresSlope) {
+  EXPECT_NEAR(rt::trend({0, 1, 2, 3}, {1, 3, 5, 7}), 2.0, 1e-12);
+  EXPECT_NEAR(rt::trend({0, 1, 2}, {1, 1, 1}), 0.0, 1e-12);
+  EXPECT_EQ(rt::trend({1}, {5}), 0.0);  // one point: no trend
+}
+
+// Runs the rain protocol on a small box (300 grains, 0.5 s, the last 0.2 s averaged).
+std::unique_ptr<rt::Scene> rain_scene(const std::vector<std::string>& extra, rt::Model& m, rt::State& s,
+                                      std::unique_ptr<rt::SceneRun>& sr, rt::RunReport& rep) {
+  rt::SceneOptions o;
+  o.quiet = true;
+  o.cache_dir = ::testing::TempDir() + "/incline_cache";
+  std::vector<std::string> set = {"grains.0.fill.count=300", "grains.0.fill.hi=[0.20,0.10,0.12]",
+                                  "incline.duration=0.5", "incline.average=0.2"};
+  set.insert(set.end(), extra.begin(), extra.end());
+  auto sc = rt::load_scene("config/incline_rain.yaml", set, o);
+  m = sc->sc.model;
+  s = sc->start;
+  rt::RunOptions ro;
+  ro.progress_every = 0;
+  rt::Run run(m, s, sc->plan, ro);
+  sr = sc->begin(run);
+  for (rt::Observer* ob : sr->observers()) run.add_observer(ob);
+  rep = run.run();
+  return sc;
+}
+
+TEST(InclineRain, GrainsThatTouchThePlaneAreGluedWhereTheyLand) {
+  rt::Model m;
+  rt::State s;
+  std::unique_ptr<rt::SceneRun> sr;
+  rt::RunReport rep;
+  auto sc = rain_scene({"incline.angle_deg=20"}, m, s, sr, rep);
+  ASSERT_EQ(rep.status, "ok") << rep.message;
+  const auto& ob = static_cast<rt::InclineRun&>(*sr).observer();
+  // The tilt was there from the start; no grain began glued, and those glued now all touched the plane.
+  EXPECT_NEAR(m.gravity.x(), 9.81 * std::sin(20 * kPi / 180), 1e-12);
+  int glued = 0;
+  for (int i = 0; i < m.n_grains; ++i) {
+    EXPECT_FALSE(sc->sc.model.grain_fixed[i]);
+    if (!m.grain_fixed[i]) {
+      EXPECT_GE(s.pos[i].z() - m.grain_radius[i], -1e-3) << "a free grain sank into the plane";
+      continue;
+    }
+    ++glued;
+    EXPECT_LT(s.pos[i].z() - m.grain_radius[i], 0.0) << "glued without touching the plane";
+    EXPECT_EQ(s.vel[i].norm(), 0.0);
+  }
+  EXPECT_EQ(glued, ob.glued());
+  EXPECT_GT(glued, 20);      // the first to land form a base ...
+  EXPECT_LT(glued, 200);     // ... the others rest on it
+  // 20 degrees is far below any onset: the deposit is coming to rest.
+  EXPECT_FALSE(ob.flowing());
+  EXPECT_LT(ob.end_dvdt(), 0.0);
+}
+
+TEST(InclineRain, SteepEnoughTheDepositFlows) {
+  rt::Model m;
+  rt::State s;
+  std::unique_ptr<rt::SceneRun> sr;
+  rt::RunReport rep;
+  auto sc = rain_scene({"incline.angle_deg=60"}, m, s, sr, rep);
+  ASSERT_EQ(rep.status, "ok") << rep.message;
+  const auto& ob = static_cast<rt::InclineRun&>(*sr).observer();
+  EXPECT_TRUE(ob.flowing());
+  EXPECT_GT(ob.end_vx(), 0.5);
+  EXPECT_GT(ob.profile().height, 0.0);
+}
+
+TEST(InclineRain, BadInputIsRefused) {
+  rt::SceneOptions o;
+  o.quiet = true;
+  auto refused = [&o](const std::vector<std::string>& set, const std::string& what) {
+    try {
+      rt::load_scene("config/incline_rain.yaml", set, o);
+      ADD_FAILURE() << "accepted: " << what;
+    } catch (const rt::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  refused({"grains.0.fixed=true"}, "fixed");
+  refused({"walls=[]"}, "plane floor");
+}
+
 }  // namespace

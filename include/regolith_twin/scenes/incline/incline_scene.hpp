@@ -11,7 +11,15 @@
 //   mode steady: theta fixed; over the last `average` s of the run, the
 //                velocity and packing profiles in horizontal layers, the
 //                Bagnold fit v_x(z) = A [1 - (1 - z/h)^(3/2)] and the inertial
-//                number it implies, I = 3 d A / (2 h^(3/2) sqrt(Phi g cos theta)).
+//                number it implies, I = 3 d A / (2 h^(3/2) sqrt(Phi g cos theta));
+//   mode rain:   the published protocol: theta fixed from the start, the
+//                grains (generated loose above the plane, not settled) rain
+//                onto the tilted plane; every grain that touches the plane is
+//                glued where it touches (the first to land form the rough
+//                base); at the end the bed is flowing if its mean v_x over the
+//                last `average` s ends above `flow_speed` sqrt(g d) and, at
+//                its trend over that window, stays above it for one more
+//                window; the profiles and Bagnold fit as in steady mode.
 #pragma once
 
 #include <memory>
@@ -24,6 +32,7 @@ namespace rt {
 
 struct InclineSpec {
   bool onset = false;          // mode: onset (true) or steady
+  bool rain = false;           // mode: rain (the published protocol)
   double angle_deg = 25;       // steady: the tilt
   double start_deg = 15, step_deg = 1, max_deg = 45, hold = 1.0;  // onset
   double flow_speed = 0.01;    // onset: flowing above this many sqrt(g d)
@@ -47,15 +56,18 @@ struct Profile {
 double bagnold_amplitude(const std::vector<double>& z, const std::vector<double>& v, double h, double* rms);
 // I = 3 d A / (2 h^(3/2) sqrt(Phi g cos theta)).
 double bagnold_inertial_number(double a, double d, double h, double phi, double g, double theta);
+// Least-squares slope of v against t.
+double trend(const std::vector<double>& t, const std::vector<double>& v);
 // The onset test at the end of a hold: v_end above `threshold`, and still above it after one more hold
 // at the hold-end trend, v_end + dvdt_end hold (m/s, m/s^2, s).
 bool onset_flowing(double v_end, double dvdt_end, double hold, double threshold);
 
 class InclineObserver : public Observer {
  public:
+  // rain: base_top and bed_top are found at the start of the averaging window; floor_z is the plane's height.
   InclineObserver(const InclineSpec& sp, double base_top, double bed_top, double diameter, double area,
-                  double g)
-      : sp_(sp), base_(base_top), top_(bed_top), d_(diameter), area_(area), g_(g) {}
+                  double g, double floor_z = 0)
+      : sp_(sp), base_(base_top), top_(bed_top), d_(diameter), area_(area), g_(g), floor_(floor_z) {}
   void prepare(Model& m, State& s) override;
   bool after_step(Model& m, State& s) override;
   void finish(Model& m, State& s) override;
@@ -69,11 +81,22 @@ class InclineObserver : public Observer {
   double onset_deg() const { return onset_deg_; }  // < 0: none up to max_deg
   const Profile& profile() const { return prof_; }
   double mean_vx(const Model& m, const State& s) const;
+  // rain: the end state (mean v_x at the end and its trend over the last `average` s) and the verdict.
+  double end_vx() const { return end_vx_; }
+  double end_dvdt() const { return end_dvdt_; }
+  bool flowing() const { return flowing_; }
+  int glued() const { return glued_; }
 
  private:
   void tilt(Model& m, State& s, double deg);
+  void find_layers(const Model& m, const State& s);  // rain: base and top at the start of the window
   InclineSpec sp_;
-  double base_, top_, d_, area_, g_;
+  double base_, top_, d_, area_, g_, floor_;
+  int glued_ = 0;                 // rain: grains glued to the plane
+  bool window_started_ = false;   // rain: base and top found
+  std::vector<double> win_t_, win_v_;  // rain: mean v_x every 0.01 s over the window
+  double end_vx_ = 0, end_dvdt_ = 0;
+  bool flowing_ = false;
   static constexpr double kTrendWindow = 0.25;  // onset: the hold-end trend is read over this fraction of the hold
   struct Hold {
     double theta_deg, v_end, dvdt_end;  // the tilt, mean v_x at the end of its hold, and its trend there
@@ -97,6 +120,7 @@ class InclineScene : public Scene {
   std::string file;
   InclineSpec spec;
   double base_top = 0, top = 0, diameter = 0, area = 0, packing = 0;
+  double floor_z = 0;  // rain: the plane the grains are glued to
   int grains = 0, base_grains = 0;
   std::string bed_cache;
 };

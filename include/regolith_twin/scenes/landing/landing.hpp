@@ -84,18 +84,41 @@ void place_lander(const Model& m, State& s, int b, const LandingSpec& spec);
 std::vector<Vec3> lander_corners(const Model& m, const State& s, int b);
 std::vector<Vec3> lander_corners(const BodyModel& bm, const BodyState& bs);
 
+// The lander's figures at the end of its collision (docs/scenes.md A.9).
+struct Departure {
+  double t = 0;                  // s
+  double v_out = 0;              // centre-of-mass speed, m/s
+  double e_lin_out = 0, e_rot_out = 0;  // J
+  double angle_out_deg = 0;      // outgoing velocity from the trim-plane normal, deg
+  double spin_out = 0;           // |omega|, rad/s
+  double h_liftoff = 0;          // centre-of-mass height above the trim plane, m
+  double travel_distance = 0;    // ballistic, to the next impact, m (0 if not moving away)
+  double travel_time = 0;        // s
+  double second_impact_speed = 0;      // m/s
+  double second_impact_angle_deg = 0;  // from the normal, deg
+};
+
 struct LandingOutcome {
   bool contact = false;          // the lander touched the bed
-  // Lift-off: all eight corners above the trim plane, no contact left and the
-  // centre of mass moving away from the surface. A contact with the bed
-  // within the after_liftoff window cancels it (the lander had not left:
-  // corners of a tilted lander can all be above the plane in mid-collision
-  // while it turns, on grains that stand above the plane); touches by ejected
-  // grains (centre more than one mean radius above the plane) do not.
+  // Lift-off (the published definition, the primary figures): after first
+  // contact, once a corner has been below the trim plane (the top of the
+  // bed cut at the rim), the first moment all eight corners are above it;
+  // V_out is the centre-of-mass speed then, and the collision lasts from
+  // first contact to then. A lander that never puts a corner under the
+  // plane (a bounce off a boulder or a cliff) lifts off at its clear
+  // lift-off.
   bool lifted_off = false;
-  int relandings = 0;            // lift-offs cancelled by a renewed contact
+  // Clear lift-off (the variant, which also ends the run): all eight corners
+  // above the trim plane, no contact left and the centre of mass moving away
+  // from the surface. A contact with the bed within the after_liftoff window
+  // cancels it (the lander had not left: corners of a tilted lander can all
+  // be above the plane in mid-collision while it turns, on grains that stand
+  // above the plane); touches by ejected grains (centre more than one mean
+  // radius above the plane) do not.
+  bool lifted_off_clear = false;
+  int relandings = 0;            // clear lift-offs cancelled by a renewed contact
   std::string ended_by;          // after_liftoff | trapped | max_after_contact | max_time
-  double t_contact = 0, t_liftoff = 0, t_end = 0;  // s
+  double t_contact = 0, t_liftoff = 0, t_liftoff_clear = 0, t_end = 0;  // s
   double v_in = 0, v_out = 0;    // centre-of-mass speed at first contact and at lift-off, m/s
   double speed_ratio = 0;        // v_out / v_in
   double e_lin_in = 0, e_rot_in = 0, e_lin_out = 0, e_rot_out = 0;  // J
@@ -103,7 +126,9 @@ struct LandingOutcome {
   double angle_out_deg = 0;      // outgoing velocity from the trim-plane normal, deg
   double spin_out = 0;           // |omega| at lift-off, rad/s
   double collision_duration = 0; // first contact to lift-off, s
-  double max_penetration = 0;    // deepest corner below the trim plane, m
+  Departure clear;               // the figures at the clear lift-off (variant)
+  double speed_ratio_clear = 0, collision_duration_clear = 0;
+  double max_penetration = 0;    // deepest corner below the trim plane from first contact to the clear lift-off, m
   double h_liftoff = 0;          // centre-of-mass height above the trim plane at lift-off, m
   double travel_distance = 0;    // ballistic, to the next impact, m
   double travel_time = 0;        // s
@@ -141,12 +166,14 @@ class LandingTracker {
 
  private:
   bool trapped(double t, const BodyState& bs);
+  Departure depart(double t, const BodyState& bs) const;
   BodyModel bm_;
   LandingSpec sp_;
   Vec3 g_;
   double t_start_ = 0;
   double liftoff_com_ = 0;      // lowest centre-of-mass height above the plane with every corner above it
   double trapped_since_ = -1;
+  bool went_under_ = false;     // a corner has been below the trim plane since first contact
   LandingOutcome o_;
 };
 
@@ -182,6 +209,10 @@ struct LandingOptions {
   std::string out_dir;           // series.csv, summary.json, surface.csv (empty: nothing written)
   double progress_every = 2.0;   // wall seconds between progress lines (<= 0: none)
 };
+
+// The outcome's figures as JSON (summary.json "outcome", regolith_bag_outcome).
+class JsonObject;
+void landing_outcome_json(const LandingOutcome& o, JsonObject& out);
 
 // Run the landing from the placed state to the run end (through the run
 // loop, with the landing's observers), writing series.csv and surface.csv

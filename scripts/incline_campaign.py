@@ -4,8 +4,10 @@
   incline_campaign.py BIN OUT DOCS run [RUN...]   runs (default: all), one seed each
   incline_campaign.py BIN OUT DOCS report         DOCS/report.md and incline.png
 
-Runs: onset_MAT (1-degree steps from rest, MAT = moderate or gravel) and MAT_ANGLE
-(flow at a fixed ANGLE: profiles over the last second, Bagnold fit, I). A
+Runs: onset_MAT (1-degree steps from rest, MAT = moderate or gravel), MAT_ANGLE
+(flow at a fixed ANGLE: profiles over the last second, Bagnold fit, I) and rain_MAT_ANGLE (the
+published protocol, config/incline_rain.yaml: grains rained onto the plane tilted at ANGLE, 8 s,
+flowing or not over the last 2 s; the onset is the smallest angle that flows). A
 finished run's summary.json (with profile.csv and series.csv) goes to DOCS/RUN/ (committed:
 a campaign resumes on any machine; INCLINE_RERUN=1 runs them again); a run
 that stopped leaves failed.txt there, not retried.
@@ -22,6 +24,11 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib
 import campaign_cli  # noqa: E402
 
 CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "incline_moderate.yaml")
+RAIN_CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "incline_rain.yaml")
+# The published protocol at fixed angles 1 degree apart around the published onsets (gravel 39-40,
+# moderate 30-31 deg); each run 8 s, judged over its last 2 s (config/incline_rain.yaml).
+RAIN = {"moderate": [29, 30, 31, 32], "gravel": [37, 38, 39, 40, 41]}
+PUBLISHED_ONSET = {"moderate": (30, 31), "gravel": (39, 40)}
 
 
 def mat(m):
@@ -61,11 +68,22 @@ for key, (m, angles, duration, window) in SERIES.items():
         WINDOW[series_run(key, a)] = window
 
 
+def rain_run(m, a):
+    return "rain_%s_%g" % (m, a)
+
+
+for m, angles in RAIN.items():
+    for a in angles:
+        RUNS[rain_run(m, a)] = (mat(m) + ["incline.angle_deg=%g" % a],
+                                "published protocol: %s rained onto the plane at %g deg" % (m, a))
+
+
 def run_one(bin_dir, out, docs, name):
     keep = os.path.join(docs, name)
     if campaign_cli.kept(keep, "INCLINE_RERUN") is not None:
         return
-    s = campaign_cli.run_and_keep(bin_dir, CONFIG, os.path.join(out, name), keep, RUNS[name][0], {"run": name},
+    config = RAIN_CONFIG if name.startswith("rain_") else CONFIG
+    s = campaign_cli.run_and_keep(bin_dir, config, os.path.join(out, name), keep, RUNS[name][0], {"run": name},
                                   copies=["profile.csv", "series.csv"])
     if s is not None:
         print("%s: %s (%.0f s)" % (name, json.dumps(s["observers"]["incline"])[:300], s["campaign"]["wall_seconds"]),
@@ -129,6 +147,23 @@ def base_friction(o, a, g=9.81):
     return math.tan(th) - a / (g * math.cos(th))
 
 
+def rain_onset(done, m):
+    """(onset angle or None, [(angle, flowing, end v, trend)]) of a material's rain runs: the smallest
+    angle run that flows, every larger angle run flowing too (else None, with the runs)."""
+    rows = []
+    for a in RAIN[m]:
+        n = rain_run(m, a)
+        if n in done:
+            o = done[n]["observers"]["incline"]
+            rows.append((a, o["flowing"], o["end_mean_vx"], o["end_dvdt"]))
+    onset = None
+    for k, (a, fl, _, _) in enumerate(rows):
+        if fl and all(r[1] for r in rows[k:]):
+            onset = a
+            break
+    return onset, rows
+
+
 def window_of(name):
     """The averaging window (s) of a fixed-angle run."""
     return WINDOW[name]
@@ -157,7 +192,13 @@ def report(docs):
             continue
         o = done[n]["observers"]["incline"]
         w = done[n]["campaign"]["wall_seconds"]
-        if o["mode"] == "onset":
+        if o["mode"] == "rain":
+            res = "%s: mean v_x %.3g m/s at the end, trend %+.3g m/s² over the last 2 s; %d glued; A = %.4g m/s, " \
+                  "h = %.1f d, Phi = %.3f, I = %.4g" % (
+                      "flowing" if o["flowing"] else "not flowing", o["end_mean_vx"], o["end_dvdt"],
+                      o["glued_grains"], o["bagnold_a"], o["flow_height"] / done[n]["bed"]["diameter"],
+                      o["packing_mean"], o["inertial_number"])
+        elif o["mode"] == "onset":
             trend = o.get("hold_end_dvdt", [])
             ends = ["%.0f°: %.2g m/s" % (a, v) + (" (%+.2g m/s²)" % trend[k] if k < len(trend) else "")
                     for k, (a, v) in enumerate(zip(o["hold_angles_deg"], o["hold_end_mean_vx"]))]
@@ -216,6 +257,16 @@ def report(docs):
             ax[2].plot(ii, [mu1 + (mu2 - mu1) * i / (i0 + i) for i in ii], "-", lw=1, label="%s fit" % m)
         elif pts:
             fits.append("| %s | %d | (a fit needs 4 angles) | | | |" % (m, len(pts)))
+    lines += ["", "Onset by the published protocol (rain onto the tilted plane; the smallest angle whose deposit flows, "
+              "every steeper one flowing too):", "", "| material | angles run | flowing at | onset | published |",
+              "|---|---|---|---|---|"]
+    for m in RAIN:
+        onset, rows = rain_onset(done, m)
+        if not rows:
+            continue
+        lines.append("| %s | %s | %s | %s | %d–%d° |" % (
+            m, ", ".join("%g°" % r[0] for r in rows), ", ".join("%g°" % r[0] for r in rows if r[1]) or "none",
+            "%g°" % onset if onset is not None else "none in the range run", *PUBLISHED_ONSET[m]))
     lines += campaign_cli.failure_lines(docs)
     lines += ["", "Fitted mu(I) = mu1 + (mu2 - mu1) / (I0 / I + 1):", "",
               "| material | angles | mu1 | mu2 | I0 | rms |", "|---|---|---|---|---|---|"] + fits

@@ -1,0 +1,345 @@
+#!/usr/bin/python3
+"""The figures table (docs/validation/figures.csv) and the reproduction page's table, from the
+committed results (docs/validation.md "Figures table").
+
+  figures.py [--check]     write docs/validation/figures.csv (--check: compare with the committed
+                           file instead, exit 1 if it differs or is incomplete)
+
+Columns: id,value,sd,n,unit,command. `value` is the mean over the n runs (repeats, beds, seeds,
+aim points), `sd` their sample standard deviation (empty when n = 1), `NA` with n = 0 when not run
+yet; `command` the command that produces the runs. Units SI (m, s, kg/m^3), angles in degrees,
+collected masses in mg. Every figure is computed here from the results under docs/validation/
+(never typed in); the ids are those of ids() below.
+"""
+import csv
+import glob
+import io
+import json
+import math
+import os
+import sys
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+DOCS = os.path.join(ROOT, "docs", "validation")
+OUT = os.path.join(DOCS, "figures.csv")
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
+
+MATERIALS = ("gravel", "moderate")
+ATTITUDES = ("Flat", "BCF", "FCF")
+ANGLES = (0, 15, 30, 45, 60)
+
+
+def ids():
+    """Every figure id, in the table's order, with its unit."""
+    out = []
+    for m in MATERIALS:
+        for d in (15, 30, 40):
+            out += [("bed.mascot.%s.d%d.grains" % (m, d), "1"), ("bed.mascot.%s.d%d.packing" % (m, d), "1")]
+    out += [("bed.sampler.grains", "1"), ("bed.sampler.bulk_density", "kg/m3")]
+    for t in ("gb", "gbb"):
+        for h in (8, 10, 12):
+            out.append(("bed.bucket.%s.h%d.grains" % (t, h), "1"))
+    out.append(("bed.bucket.gb5mm.h10.grains", "1"))
+    units = {"speed_ratio": "1", "travel": "m", "collision": "s", "penetration": "m"}
+    for m in MATERIALS:
+        for att in ATTITUDES:
+            for a in ANGLES:
+                for k in ("speed_ratio", "travel", "collision", "penetration"):
+                    out.append(("mascot.d30.%s.%s.a%d.%s" % (m, att, a, k), units[k]))
+    for d in ("d15", "d40"):
+        for m in MATERIALS:
+            for k in ("speed_ratio", "travel", "penetration"):
+                out.append(("mascot.%s.%s.BCF.a30.%s" % (d, m, k), units[k]))
+    for m in MATERIALS:
+        for k in ("speed_ratio", "travel"):
+            out.append(("mascot.d30g12.%s.BCF.a30.%s" % (m, k), units[k]))
+    for m in ("moderate", "gravel"):
+        out.append(("mascot.d30.%s.BCF.a30.ejected_volume" % m, "m3"))
+    out += [("sampler.v300.z.t45us", "1"), ("sampler.v300.z.t1250us", "1"), ("sampler.v300.z.t12500us", "1"),
+            ("sampler.v300.z_misfit_deg.t1250us", "deg"),
+            ("sampler.v300.wave_exponent.t12us", "1"), ("sampler.v300.wave_exponent.t62us", "1"),
+            ("sampler.v300.depth_over_radius.t0.25s", "1"), ("sampler.v300.depth_over_radius.t1s", "1"),
+            ("sampler.v300.ejection_angle_mode", "deg"), ("sampler.v50.ejection_angle_mode", "deg"),
+            ("sampler.v300.bed_energy_fraction.t120us", "1"),
+            ("sampler.v300.collected_mg.t1s", "mg"), ("sampler.v300.runs_ge_100mg_fraction", "1"),
+            ("sampler.v50.horn_grains.cyl3.t1s", "1"), ("sampler.v50.horn_grains.cyl4.t1s", "1")]
+    for t in ("gb", "gbb", "gb5mm"):
+        for v in ("0.25", "0.5", "0.75", "1.0"):
+            out.append(("bucket.%s.h10.v%s.zstop" % (t, v), "m"))
+    for t in ("gb", "gbb", "gb5mm"):
+        out += [("bucket.%s.h10.alpha" % t, "1"), ("bucket.%s.h10.bounced_fraction" % t, "1")]
+    out += [("bucket.gb5mm.h10.f0", "N"), ("bucket.gb5mm.h10.inv_d1", "1/m"), ("bucket.gb.h10.f0", "N"),
+            ("bucket.gb.h10.inv_d1", "1/m")]
+    out += [("incline.onset.gravel", "deg"), ("incline.onset.moderate", "deg"),
+            ("incline.onset_tilted.gravel", "deg"), ("incline.onset_tilted.moderate", "deg"),
+            ("incline.moderate.mu_s", "1"), ("incline.moderate.mu_2", "1"), ("incline.moderate.I0", "1"),
+            ("repose.gravel", "deg"), ("repose.moderate", "deg")]
+    for r in ("base", "collisionless", "nondissipative", "pen2", "pen4", "pen6", "ero1", "ero16", "k8e3", "k8e4",
+              "k8e5", "k8e6"):
+        out.append(("plume.%s.rate" % r, "1/s"))
+    for e in ("0.6", "0.8"):
+        for mu in ("0.2", "0.5", "0.8", "1.4"):
+            out.append(("plume.e%s_mu%s.rate" % (e, mu), "1/s"))
+    out += [("plume.base.peak_collision_fraction", "1"), ("plume.base.peak_collision_time", "s")]
+    return out
+
+
+def stats(xs):
+    """(mean, sd or None, n) of a list of numbers."""
+    xs = [float(x) for x in xs if x is not None and x == x]
+    n = len(xs)
+    if n == 0:
+        return None, None, 0
+    m = sum(xs) / n
+    sd = math.sqrt(sum((x - m) ** 2 for x in xs) / (n - 1)) if n > 1 else None
+    return m, sd, n
+
+
+def load_json(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+# --- the sections: each returns {id: (list of values, command)} ---------------------------------
+
+def beds():
+    out = {}
+    root = os.path.join(DOCS, "beds", "prepared")
+
+    def kept(name):
+        f = os.path.join(root, name, "summary.json")
+        return load_json(f)["bed"] if os.path.exists(f) else None
+
+    for m in MATERIALS:
+        for d in (15, 30, 40):
+            names = ["mascot_%s_d%d" % (m, d)] + (["mascot_%s_d%d_s2" % (m, d), "mascot_%s_d%d_s3" % (m, d)]
+                                                  if d == 30 else [])
+            got = [b for b in (kept(n) for n in names) if b]
+            cmd = "scripts/validate_beds prepare %s" % " ".join(names)
+            out["bed.mascot.%s.d%d.grains" % (m, d)] = ([b["grains"] for b in got], cmd)
+            out["bed.mascot.%s.d%d.packing" % (m, d)] = ([b["packing"] for b in got], cmd)
+    names = ["sampler_gravel", "sampler_gravel_s2", "sampler_gravel_s3"]
+    got = [b for b in (kept(n) for n in names) if b]
+    cmd = "scripts/validate_beds prepare %s" % " ".join(names)
+    out["bed.sampler.grains"] = ([b["grains"] for b in got], cmd)
+    out["bed.sampler.bulk_density"] = ([b["bulk_density"] for b in got], cmd)
+    return out
+
+
+def bucket():
+    import bucket_campaign as bc
+    out = {}
+    docs = os.path.join(DOCS, "bucket")
+    loaded = bc.load(docs)
+    tags = {"gb": "gb", "gbb": "gbb", "gb5mm": "gb"}
+    for t, h, bed in [(t, h, "%s_%d" % (t, h)) for t in ("gb", "gbb") for h in (8, 10, 12)] + [("gb5mm", 10,
+                                                                                                 "gb_10_5mm")]:
+        d = loaded.get(bed)
+        cmd = "scripts/validate_bucket run %s" % bed
+        runs = (d["sweep"] + [s for v in d["aims"] for s in d["aims"][v]]) if d else []
+        out["bed.bucket.%s.h%d.grains" % (t, h)] = ([runs[0]["bed"]["grains"]] if runs else [], cmd)
+        if h != 10:
+            continue
+        for v in bc.AIM_SPEEDS:
+            out["bucket.%s.h10.v%s.zstop" % (t, "%g" % v if v != 1.0 else "1.0")] = (
+                bc.at_speed(d, v) if d else [], cmd)
+        f = bc.bed_figures(d) if d else None
+        out["bucket.%s.h10.alpha" % t] = ([f["alpha"]] if f and f["alpha"] == f["alpha"] else [], cmd)
+        out["bucket.%s.h10.bounced_fraction" % t] = ([f["bounced"] / f["runs"]] if f and f["runs"] else [], cmd)
+        if t in ("gb", "gb5mm"):
+            ok = f and f["f0"] == f["f0"]
+            out["bucket.%s.h10.f0" % t] = ([f["f0"]] if ok else [], cmd)
+            out["bucket.%s.h10.inv_d1" % t] = ([f["inv_d1"]] if ok else [], cmd)
+    del tags
+    return out
+
+
+def incline():
+    import incline_campaign as ic
+    out = {}
+    docs = os.path.join(DOCS, "incline")
+    done = {n: load_json(os.path.join(docs, n, "summary.json")) for n in ic.RUNS
+            if os.path.exists(os.path.join(docs, n, "summary.json"))}
+    for m in MATERIALS:
+        onset, rows = ic.rain_onset(done, m)
+        cmd = "scripts/validate_incline run %s" % " ".join(ic.rain_run(m, a) for a in ic.RAIN[m])
+        out["incline.onset.%s" % m] = ([onset] if onset is not None else [], cmd)
+        n = "onset_%s" % m
+        o = done.get(n, {}).get("observers", {}).get("incline")
+        out["incline.onset_tilted.%s" % m] = ([o["onset_deg"]] if o and o["onset_deg"] >= 0 else [],
+                                              "scripts/validate_incline run %s" % n)
+    fit = ic.steady_fit(done, "moderate") if hasattr(ic, "steady_fit") else None
+    cmd = "scripts/validate_incline run %s" % " ".join(ic.rain_run("moderate", a) for a in ic.RAIN["moderate"])
+    for k, i in (("mu_s", 0), ("mu_2", 1), ("I0", 2)):
+        out["incline.moderate.%s" % k] = ([fit[i]] if fit else [], cmd)
+    return out
+
+
+def repose():
+    out = {}
+    f = os.path.join(DOCS, "repose", "figures.json")
+    got = load_json(f) if os.path.exists(f) else {}
+    for m in MATERIALS:
+        r = got.get(m)
+        out["repose.%s" % m] = ((r["angles"], r["command"]) if r else ([], "scripts/validate repose"))
+    return out
+
+
+PLUME_ALIASES = {"pen4": "base", "ero1": "base", "k8e3": "base", "e0.8_mu0.2": "base"}
+
+
+def plume():
+    out = {}
+    docs = os.path.join(DOCS, "plume")
+    names = ["base", "collisionless", "nondissipative", "pen2", "pen4", "pen6", "ero1", "ero16", "k8e3", "k8e4",
+             "k8e5", "k8e6"] + ["e%s_mu%s" % (e, mu) for e in ("0.6", "0.8") for mu in ("0.2", "0.5", "0.8", "1.4")]
+    for n in names:
+        run = PLUME_ALIASES.get(n, n)
+        rates = []
+        for f in sorted(glob.glob(os.path.join(docs, "%s_s*" % run, "summary.json"))):
+            s = load_json(f)
+            rates.append(s["observers"]["erosion"]["erosion_rate"])
+        out["plume.%s.rate" % n] = (rates, "scripts/validate_plume run %s" % run)
+    peaks, times = [], []
+    for f in sorted(glob.glob(os.path.join(docs, "base_s*", "n_of_t.csv"))):
+        rows = list(csv.DictReader(open(f)))
+        if rows and "touching_fraction" in rows[0]:
+            best = max(rows, key=lambda r: float(r["touching_fraction"]))
+            peaks.append(float(best["touching_fraction"]))
+            times.append(float(best["t"]))
+    out["plume.base.peak_collision_fraction"] = (peaks, "scripts/validate_plume run base")
+    out["plume.base.peak_collision_time"] = (times, "scripts/validate_plume run base")
+    return out
+
+
+# MASCOT landings: the campaign records of runs on the shipped beds (grids listed here; the grids of
+# earlier beds are kept under docs/validation/campaign/lattice_beds/ and not read).
+MASCOT_GRIDS = {"first_look": "scripts/campaign first_look"}
+MASCOT_KEYS = {"speed_ratio": "speed_ratio", "travel": "travel_distance", "collision": "collision_duration",
+               "penetration": "max_penetration", "ejected_volume": "ejected_volume"}
+
+
+def mascot():
+    vals = {}
+    for grid, cmd in MASCOT_GRIDS.items():
+        for f in sorted(glob.glob(os.path.join(DOCS, "campaign", grid, "runs", "*.json"))):
+            r = load_json(f)
+            s = r.get("summary") or {}
+            if r.get("sweep_run", {}).get("status") != "ok" or s.get("status") != "ok":
+                continue
+            sw, inp, oc = r["sweep_run"], s["input"], s["outcome"]
+            depth = "d%d" % round(100 * sw["depth"])
+            if abs(inp["gravity"] - 1.2e-4) < 1e-9:
+                depth += "g12"
+            elif abs(inp["gravity"] - 2.5e-4) > 1e-9 or inp.get("slope_deg", 0) != 0:
+                continue
+            if abs(inp["speed"] - 0.19) > 1e-9:
+                continue
+            base = "mascot.%s.%s.%s.a%d" % (depth, sw["material"], sw["attitude"], round(sw["angle"]))
+            for k, key in MASCOT_KEYS.items():
+                vals.setdefault("%s.%s" % (base, k), ([], cmd))[0].append(oc[key])
+    return vals
+
+
+def sampler():
+    """Runs on the shipped beds: docs/validation/sampler/shots/<run>/summary.json, <run> = v300_b<k>
+    (to 0.25 s at the scene's stiffness), v300_1s_b<k> (1 s, stiffness schedule), v50_b<k>, v50_1s_b<k>."""
+    out = {}
+    root = os.path.join(DOCS, "sampler", "shots")
+    cmd = "scripts/validate_sampler shots"
+
+    def runs(prefix):
+        got = []
+        for d in sorted(glob.glob(os.path.join(root, prefix + "_b*"))):
+            f = os.path.join(d, "summary.json")
+            if os.path.exists(f) and load_json(f).get("status") == "ok":
+                got.append((d, load_json(f)))
+        return got
+
+    r300, r300_1s, r50, r50_1s = runs("v300"), runs("v300_1s"), runs("v50"), runs("v50_1s")
+    early = r300 + r300_1s  # both resolve the first milliseconds at the scene's stiffness
+
+    def zfit(s, k, key):
+        z = s["observers"].get("zmodel", {}).get("t%d" % k, {}).get("fixed_h0")
+        return z.get(key) if z and z.get("cells", 0) > 0 else None
+
+    out["sampler.v300.z.t45us"] = ([zfit(s, 0, "z") for _, s in early], cmd)
+    out["sampler.v300.z.t1250us"] = ([zfit(s, 1, "z") for _, s in early], cmd)
+    out["sampler.v300.z.t12500us"] = ([zfit(s, 2, "z") for _, s in early], cmd)
+    out["sampler.v300.z_misfit_deg.t1250us"] = ([zfit(s, 1, "misfit_sd_deg") for _, s in early], cmd)
+    out["sampler.v300.wave_exponent.t12us"] = ([s["observers"]["wave"]["t0"]["slope"] for _, s in early], cmd)
+    out["sampler.v300.wave_exponent.t62us"] = ([s["observers"]["wave"]["t1"]["slope"] for _, s in early], cmd)
+
+    def dr(s):
+        c = s["observers"]["crater"]
+        return c["depth"] / c["radius"] if c.get("radius") else None
+
+    out["sampler.v300.depth_over_radius.t0.25s"] = ([dr(s) for _, s in r300], cmd)
+    out["sampler.v300.depth_over_radius.t1s"] = ([dr(s) for _, s in r300_1s], cmd)
+
+    def mode(s):
+        h = s["observers"]["ejection"]["angle_histogram"]
+        b = s["observers"]["ejection"]["bin_deg"]
+        return (max(range(len(h)), key=lambda k: h[k]) + 0.5) * b if sum(h) else None
+
+    out["sampler.v300.ejection_angle_mode"] = ([mode(s) for _, s in r300 + r300_1s], cmd)
+    out["sampler.v50.ejection_angle_mode"] = ([mode(s) for _, s in r50 + r50_1s], cmd)
+
+    def energy(d):
+        f = os.path.join(d, "energy_partition.csv")
+        if not os.path.exists(f):
+            return None
+        rows = list(csv.DictReader(open(f)))
+        best = min(rows, key=lambda r: abs(float(r["t"]) - 1.2e-4))
+        return float(best["ke_bed_trans"]) + float(best["ke_bed_rot"]) if abs(float(best["t"]) - 1.2e-4) < 1e-5 \
+            else None
+
+    out["sampler.v300.bed_energy_fraction.t120us"] = ([energy(d) for d, _ in early], cmd)
+    mg = [1e6 * s["collection"]["collected_mass"] for _, s in r300_1s]
+    out["sampler.v300.collected_mg.t1s"] = (mg, cmd)
+    out["sampler.v300.runs_ge_100mg_fraction"] = ([sum(1 for x in mg if x >= 100) / len(mg)] if mg else [], cmd)
+    out["sampler.v50.horn_grains.cyl3.t1s"] = ([s["observers"]["horn"]["segment_grains"][2] for _, s in r50_1s], cmd)
+    out["sampler.v50.horn_grains.cyl4.t1s"] = ([s["observers"]["horn"]["segment_grains"][3] for _, s in r50_1s], cmd)
+    return out
+
+
+def table():
+    """The rows (id, value, sd, n, unit, command) of every figure."""
+    found = {}
+    for section in (beds, mascot, sampler, bucket, incline, repose, plume):
+        found.update(section())
+    rows = []
+    for fid, unit in ids():
+        vals, cmd = found.get(fid, ([], ""))
+        m, sd, n = stats(vals)
+        fmt = lambda x: "%.6g" % x  # noqa: E731
+        rows.append((fid, fmt(m) if n else "NA", fmt(sd) if sd is not None else "", str(n), unit, cmd))
+    return rows
+
+
+def render(rows):
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["id", "value", "sd", "n", "unit", "command"])
+    w.writerows(rows)
+    return buf.getvalue()
+
+
+def main():
+    text = render(table())
+    if len(sys.argv) > 1 and sys.argv[1] == "--check":
+        old = open(OUT).read() if os.path.exists(OUT) else ""
+        if old != text:
+            sys.stderr.write("docs/validation/figures.csv is not what the committed results give: run "
+                             "scripts/figures.py\n")
+            sys.exit(1)
+        return
+    with open(OUT, "w") as f:
+        f.write(text)
+    print("figures: %s (%d ids, %d with results)" % (os.path.relpath(OUT, ROOT), text.count("\n") - 1,
+                                                     sum(1 for r in table() if r[1] != "NA")))
+
+
+if __name__ == "__main__":
+    main()

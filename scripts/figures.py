@@ -2,8 +2,8 @@
 """The figures table (docs/validation/figures.csv) and the reproduction page's table, from the
 committed results (docs/validation.md "Figures table").
 
-  figures.py [--check]     write docs/validation/figures.csv (--check: compare with the committed
-                           file instead, exit 1 if it differs or is incomplete)
+  figures.py [--check]     write docs/validation/figures.csv and docs/reproduction.md (--check:
+                           compare with the committed files instead, exit 1 if they differ)
 
 Columns: id,value,sd,n,unit,command. `value` is the mean over the n runs (repeats, beds, seeds,
 aim points), `sd` their sample standard deviation (empty when n = 1), `NA` with n = 0 when not run
@@ -22,6 +22,7 @@ import sys
 ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 DOCS = os.path.join(ROOT, "docs", "validation")
 OUT = os.path.join(DOCS, "figures.csv")
+REPRO = os.path.join(ROOT, "docs", "reproduction.md")
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
 
@@ -326,19 +327,170 @@ def render(rows):
     return buf.getvalue()
 
 
+# --- the reproduction page ----------------------------------------------------------------------
+# Each published statement: (section, what was published, the figure ids it is compared with, a test
+# of the project's figures -> True / False / None (not run), how the project's side is shown, and the
+# reason when it does not hold). The published numbers are those of the studies' set-ups as
+# docs/scenes.md states them; the reasons are the findings of docs/validation.md.
+
+
+def _v(f, fid):
+    """The mean of a figure, or None."""
+    m, sd, n = f.get(fid, (None, None, 0))
+    return m if n else None
+
+
+def _within(f, fid, target, rel):
+    x = _v(f, fid)
+    return None if x is None else abs(x / target - 1) <= rel
+
+
+def _all(tests):
+    tests = list(tests)
+    if any(t is None for t in tests):
+        return None if not any(t is False for t in tests) else False
+    return all(tests)
+
+
+def _num(x, digits):
+    """x to `digits` significant digits, thousands separated, never in exponent form."""
+    if x == 0:
+        return "0"
+    p = digits - 1 - int(math.floor(math.log10(abs(x))))
+    x = round(x, p)
+    return "{:,.{}f}".format(x, max(p, 0))
+
+
+def _fmt(f, fid, scale=1.0, digits=3, unit=""):
+    m, sd, n = f.get(fid, (None, None, 0))
+    if not n:
+        return "not run"
+    s = _num(m * scale, digits)
+    if sd is not None:
+        s += " ± " + _num(sd * scale, 2)
+    return s + unit + (" (n = %d)" % n if n > 1 else "")
+
+
+def _order(f, ids_in_order):
+    """The figures strictly increase along the list (None if one is missing)."""
+    xs = [_v(f, i) for i in ids_in_order]
+    if any(x is None for x in xs):
+        return None
+    return all(a < b for a, b in zip(xs, xs[1:]))
+
+
+BED_COUNTS = [("gravel", 15, 28375), ("gravel", 30, 58454), ("gravel", 40, 78176), ("moderate", 15, 31082),
+              ("moderate", 30, 62551), ("moderate", 40, 83097)]
+BUCKET_COUNTS = [("gb", 8, 6274), ("gb", 10, 7987), ("gb", 12, 9682), ("gbb", 8, 6274), ("gbb", 10, 7987),
+                 ("gbb", 12, 9682)]
+BUCKET_ZSTOP = [("0.25", 0.0040), ("0.5", 0.0092), ("0.75", 0.0131), ("1.0", 0.0160)]
+
+
+def statements(f):
+    """The rows of the reproduction table: (section, published, project, verdict, command ids)."""
+    rows = []
+    for m, d, n in BED_COUNTS:
+        fid = "bed.mascot.%s.d%d.grains" % (m, d)
+        rows.append(("MASCOT bed", "%s, %d cm: %s grains (±2 %%)" % (m, d, format(n, ",")),
+                     _fmt(f, fid, digits=5), _within(f, fid, n, 0.02), [fid]))
+    rows.append(("Sampler bed", "101,657 grains (±2 %)", _fmt(f, "bed.sampler.grains", digits=6),
+                 _within(f, "bed.sampler.grains", 101657, 0.02), ["bed.sampler.grains"]))
+    rows.append(("Sampler bed", "bulk density 1,230 kg/m³ (±2 %)", _fmt(f, "bed.sampler.bulk_density", digits=4),
+                 _within(f, "bed.sampler.bulk_density", 1230, 0.02), ["bed.sampler.bulk_density"]))
+    for t, h, n in BUCKET_COUNTS:
+        fid = "bed.bucket.%s.h%d.grains" % (t, h)
+        rows.append(("Bucket bed", "%s, 10 mm beads, %d cm: %s beads (±2 %%)" % (t, h, format(n, ",")),
+                     _fmt(f, fid, digits=5), _within(f, fid, n, 0.02), [fid]))
+    rows.append(("Bucket bed", "5 mm beads, 10 cm: 67,420 beads (±2 %)", _fmt(f, "bed.bucket.gb5mm.h10.grains",
+                                                                             digits=5),
+                 _within(f, "bed.bucket.gb5mm.h10.grains", 67420, 0.02), ["bed.bucket.gb5mm.h10.grains"]))
+    for v, z in BUCKET_ZSTOP:
+        fid = "bucket.gb.h10.v%s.zstop" % v
+        ok = _within(f, fid, z, 0.20) if v != "0.25" else None
+        rows.append(("Bucket", "glass_beads 10 mm, %s m/s: z_stop %.2f cm%s" % (
+            v, 100 * z, " (±20 %)" if v != "0.25" else " (not in the check)"), _fmt(f, fid, 100, unit=" cm"), ok, [fid]))
+    b = _v(f, "bucket.gb.h10.bounced_fraction")
+    rows.append(("Bucket", "glass_beads 10 mm: the sphere never bounces",
+                 "fraction of runs that bounced: " + _fmt(f, "bucket.gb.h10.bounced_fraction", digits=2),
+                 None if b is None else b == 0, ["bucket.gb.h10.bounced_fraction"]))
+    a = [_v(f, "bucket.%s.h10.alpha" % t) for t in ("gb", "gbb")]
+    rows.append(("Bucket", "α between 0.53 and 0.73 on 10 mm beads", "glass_beads %s, glass_beads_b %s" % (
+        _fmt(f, "bucket.gb.h10.alpha"), _fmt(f, "bucket.gbb.h10.alpha")),
+        _all(None if x is None else 0.53 <= x <= 0.73 for x in a), ["bucket.gb.h10.alpha", "bucket.gbb.h10.alpha"]))
+    rows.append(("Bucket", "glass_beads 10 mm: f₀ = 15.10 N, 1/d₁ = 90.4 1/m (±20 %)", "%s, %s" % (
+        _fmt(f, "bucket.gb.h10.f0", unit=" N"), _fmt(f, "bucket.gb.h10.inv_d1", unit=" 1/m")),
+        _all([_within(f, "bucket.gb.h10.f0", 15.10, 0.2), _within(f, "bucket.gb.h10.inv_d1", 90.4, 0.2)]),
+        ["bucket.gb.h10.f0", "bucket.gb.h10.inv_d1"]))
+    for m, lo, hi in (("gravel", 39, 40), ("moderate", 30, 31)):
+        fid = "incline.onset.%s" % m
+        x = _v(f, fid)
+        rows.append(("Inclined plane", "onset, %s: %d–%d° (grains rained onto the tilted plane; ±1°)" % (m, lo, hi),
+                     _fmt(f, fid, unit="°"), None if x is None else lo - 1 <= x <= hi + 1, [fid]))
+    for m, p in (("gravel", 38.5), ("moderate", 28.0)):
+        fid = "repose.%s" % m
+        x = _v(f, fid)
+        rows.append(("Angle of repose", "%s: %.1f° (±2°)" % (m, p), _fmt(f, fid, unit="°"),
+                     None if x is None else abs(x - p) <= 2, [fid]))
+    rows.append(("Plume", "the nondissipative bed (ε = 1, μ = 0) erodes faster than the base case",
+                 "%s against %s grains/s" % (_fmt(f, "plume.nondissipative.rate"), _fmt(f, "plume.base.rate")),
+                 _order(f, ["plume.base.rate", "plume.nondissipative.rate"]),
+                 ["plume.nondissipative.rate", "plume.base.rate"]))
+    rows.append(("Plume", "without collisions the bed erodes faster than the base case",
+                 "%s against %s grains/s" % (_fmt(f, "plume.collisionless.rate"), _fmt(f, "plume.base.rate")),
+                 _order(f, ["plume.base.rate", "plume.collisionless.rate"]),
+                 ["plume.collisionless.rate", "plume.base.rate"]))
+    rows.append(("Plume", "the erosion rate rises with the gas's penetration depth (2, 4, 6 d)",
+                 "%s, %s, %s grains/s" % (_fmt(f, "plume.pen2.rate"), _fmt(f, "plume.pen4.rate"),
+                                          _fmt(f, "plume.pen6.rate")),
+                 _order(f, ["plume.pen2.rate", "plume.pen4.rate", "plume.pen6.rate"]),
+                 ["plume.pen2.rate", "plume.pen4.rate", "plume.pen6.rate"]))
+    rows.append(("Sampler", "≥ 100 mg collected after 1 s on the surface (the science requirement)",
+                 _fmt(f, "sampler.v300.collected_mg.t1s", unit=" mg") + "; fraction of shots ≥ 100 mg: " +
+                 _fmt(f, "sampler.v300.runs_ge_100mg_fraction", digits=2),
+                 None if _v(f, "sampler.v300.collected_mg.t1s") is None else _v(f, "sampler.v300.collected_mg.t1s")
+                 >= 100, ["sampler.v300.collected_mg.t1s"]))
+    return rows
+
+
+def reproduction(rows_csv):
+    """docs/reproduction.md from the figures (the rows of the table) and the explanations kept in
+    docs/reproduction.in.md (hand-written: the set-ups, the reasons for each miss)."""
+    f = {}
+    for fid, value, sd, n, unit, cmd in rows_csv:
+        f[fid] = (float(value) if value != "NA" else None, float(sd) if sd else None, int(n))
+    cmds = {r[0]: r[5] for r in rows_csv}
+    mark = {True: "✓", False: "✗", None: "–"}
+    out = ["| | published | this project | | command |", "|---|---|---|---|---|"]
+    for sec, pub, ours, ok, fids in statements(f):
+        c = sorted({cmds[i] for i in fids if cmds.get(i)})
+        out.append("| %s | %s | %s | %s | %s |" % (sec, pub, ours, mark[ok], "<br>".join("`%s`" % x for x in c)))
+    counts = {k: sum(1 for r in statements(f) if r[3] is k) for k in (True, False, None)}
+    summary = "%d statements: %d reproduced (✓), %d not (✗), %d not run yet (–)." % (
+        sum(counts.values()), counts[True], counts[False], counts[None])
+    src = os.path.join(ROOT, "docs", "reproduction.in.md")
+    text = open(src).read() if os.path.exists(src) else "# Reproduction\n\n<!-- table -->\n"
+    return text.replace("<!-- summary -->", summary).replace("<!-- table -->", "\n".join(out))
+
+
 def main():
-    text = render(table())
+    rows = table()
+    text = render(rows)
+    page = reproduction(rows)
     if len(sys.argv) > 1 and sys.argv[1] == "--check":
-        old = open(OUT).read() if os.path.exists(OUT) else ""
-        if old != text:
-            sys.stderr.write("docs/validation/figures.csv is not what the committed results give: run "
-                             "scripts/figures.py\n")
-            sys.exit(1)
+        for path, want in ((OUT, text), (REPRO, page)):
+            old = open(path).read() if os.path.exists(path) else ""
+            if old != want:
+                sys.stderr.write("%s is not what the committed results give: run scripts/figures.py\n" %
+                                 os.path.relpath(path, ROOT))
+                sys.exit(1)
         return
     with open(OUT, "w") as f:
         f.write(text)
-    print("figures: %s (%d ids, %d with results)" % (os.path.relpath(OUT, ROOT), text.count("\n") - 1,
-                                                     sum(1 for r in table() if r[1] != "NA")))
+    with open(REPRO, "w") as f:
+        f.write(page)
+    print("figures: %s (%d ids, %d with results); %s" % (os.path.relpath(OUT, ROOT), len(rows),
+                                                         sum(1 for r in rows if r[1] != "NA"),
+                                                         os.path.relpath(REPRO, ROOT)))
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 #!/usr/bin/python3
-"""The figures table (docs/validation/figures.csv, docs/validation.md "Figures table"): it is what the
-committed results give (regenerated and compared), every id is present once, in order, and every
+"""The figures table (docs/validation/figures.csv, docs/validation.md "Figures table") and the
+reproduction page (docs/reproduction.md): they are what the committed results give (regenerated and
+compared), every id is present once, in order, and every
 row is well formed: a number or NA, NA exactly when no run is behind it (n = 0), a standard
 deviation exactly when n > 1, a unit and, for every figure with runs, the command that made them.
 The generator's statistics are checked on numbers worked by hand."""
@@ -24,6 +25,23 @@ class FiguresTable(unittest.TestCase):
         self.assertEqual(open(os.path.join(ROOT, "docs", "validation", "figures.csv")).read(),
                          figures.render(figures.table()),
                          "docs/validation/figures.csv is stale: run scripts/figures.py")
+
+    def test_committed_reproduction_page_is_what_the_results_give(self):
+        self.assertEqual(open(os.path.join(ROOT, "docs", "reproduction.md")).read(),
+                         figures.reproduction(figures.table()),
+                         "docs/reproduction.md is stale: run scripts/figures.py")
+
+    def test_verdicts(self):
+        # Within the tolerance or not, on numbers worked by hand; a figure not run gives no verdict.
+        f = {"a": (10.15, None, 1), "b": (12.5, 0.1, 3), "c": (None, None, 0)}
+        self.assertTrue(figures._within(f, "a", 10.0, 0.02))
+        self.assertFalse(figures._within(f, "b", 10.0, 0.2))
+        self.assertIsNone(figures._within(f, "c", 10.0, 0.2))
+        self.assertTrue(figures._order(f, ["a", "b"]))
+        self.assertFalse(figures._order(f, ["b", "a"]))
+        self.assertIsNone(figures._order(f, ["a", "c"]))
+        self.assertEqual(figures._fmt(f, "b", unit=" m"), "12.5 ± 0.1 m (n = 3)")
+        self.assertEqual(figures._num(62551.0, 5), "62,551")
 
     def test_every_id_once_in_order(self):
         want = [i for i, _ in figures.ids()]

@@ -40,7 +40,7 @@ class FiguresTable(unittest.TestCase):
         self.assertTrue(figures._order(f, ["a", "b"]))
         self.assertFalse(figures._order(f, ["b", "a"]))
         self.assertIsNone(figures._order(f, ["a", "c"]))
-        self.assertEqual(figures._fmt(f, "b", unit=" m"), "12.5 ± 0.1 m (n = 3)")
+        self.assertEqual(figures._fmt(f, "b", unit=" m"), "12.5 ± 0.10 m (n = 3)")
         self.assertEqual(figures._num(62551.0, 5), "62,551")
 
     def test_every_id_once_in_order(self):

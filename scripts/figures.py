@@ -216,7 +216,8 @@ def plume():
 
 # MASCOT landings: the campaign records of runs on the shipped beds (grids listed here; the grids of
 # earlier beds are kept under docs/validation/campaign/lattice_beds/ and not read).
-MASCOT_GRIDS = {"first_look": "scripts/campaign first_look"}
+MASCOT_GRIDS = {"first_look": "scripts/campaign first_look", "d30": "scripts/campaign a b",
+                "depths": "scripts/campaign c", "low_g": "scripts/campaign d"}
 MASCOT_KEYS = {"speed_ratio": "speed_ratio", "travel": "travel_distance", "collision": "collision_duration",
                "penetration": "max_penetration", "ejected_volume": "ejected_volume"}
 

@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 
 #include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/core/field.hpp"
 #include "regolith_twin/run/bed_cache.hpp"
+#include "regolith_twin/run/series.hpp"
 #include "regolith_twin/scene/yaml_reader.hpp"
 
 namespace rt {
@@ -74,7 +76,11 @@ const char* motion_name(PlaneMotion p) {
 
 }  // namespace
 
-PlumeRun::PlumeRun(const PlumeScene& scene, const Model& m) : SceneRun("plume"), scene_(scene), erosion_(scene.planes) {}
+PlumeRun::PlumeRun(const PlumeScene& scene, const Model& m)
+    : SceneRun("plume"),
+      scene_(scene),
+      impulse_(scene.planes.anchor_slot, scene.planes.erosion_slot, scene.spec.erosion_height * scene.diameter),
+      erosion_(scene.planes) {}
 
 std::unique_ptr<SceneRun> PlumeScene::begin(Run& run) const { return std::make_unique<PlumeRun>(*this, run.model()); }
 
@@ -110,10 +116,46 @@ void PlumeRun::write_summary(const std::string& path, const Model& m, const Stat
 
 void PlumeRun::write_files(const std::string& dir, const Model& m, const State& s, const RunReport& rep) const {
   erosion_.write_csv(dir + "/erosion.csv");
+  impulse_.write_csv(dir + "/crossings.csv");
+  const GasField* gas = gas_of(m);
+  if (!gas || m.n_grains == 0) return;
+  // The gas against the weight by height (docs/scenes.md D), for a grain of the bed's size.
+  const PlumeScene& sc = scene_;
+  const double d = sc.diameter, r = 0.5 * d, weight = m.grain_mass[0] * m.gravity.norm();
+  std::vector<double> heights;
+  for (int k = 1; k <= 2 * int(std::lround(sc.spec.penetration_depth + 20)); ++k) heights.push_back(0.5 * k * d);
+  write_file(dir + "/gas_forces.csv",
+             gas_force_table_csv(*gas, r, weight, sc.top - sc.planes.anchor,
+                                 heights, {0, 0.25, 0.5, 0.75, 0.9}));
+  // The grains left below the erosion plane at the end: where they are, how fast, what the gas does to them.
+  const double anchor = s.field_values[sc.planes.anchor_slot], erosion = s.field_values[sc.planes.erosion_slot];
+  std::ostringstream o;
+  o << "# grains below the erosion plane at t = " << s.time << " s (anchoring plane " << anchor / d
+    << " d, erosion plane " << erosion / d << " d above z = 0): height of the centre (d), above the anchoring plane "
+    << "(d), velocity (m/s), U(h) (m/s), the gas force at that velocity over the weight\n";
+  o << "grain,z_d,h_d,vx,vy,vz,u,gas_x_over_weight,gas_z_over_weight\n";
+  o.precision(6);
+  for (int i = 0; i < m.n_grains; ++i) {
+    if (s.pos[i].z() > erosion) continue;
+    const double h = s.pos[i].z() - anchor, w = m.grain_mass[i] * m.gravity.norm();
+    const Vec3 f = h > 0 ? gas->force_at(m.grain_radius[i], h, s.pos[i], s.vel[i]) : Vec3(Vec3::Zero());
+    o << i << ',' << s.pos[i].z() / d << ',' << h / d << ',' << s.vel[i].x() << ',' << s.vel[i].y() << ','
+      << s.vel[i].z() << ',' << (h > 0 ? gas->params().velocity(h) : 0.0) << ',' << f.x() / w << ',' << f.z() / w
+      << '\n';
+  }
+  write_file(dir + "/below_end.csv", o.str());
 }
 
 std::vector<std::pair<std::string, std::string>> PlumeRun::files() const {
-  return {{"summary", "summary.json"}, {"time series", "series.csv"}, {"erosion, every step averaged", "erosion.csv"}};
+  std::vector<std::pair<std::string, std::string>> f = {{"summary", "summary.json"},
+                                                        {"time series", "series.csv"},
+                                                        {"erosion, every step averaged", "erosion.csv"},
+                                                        {"upward crossings and their impulses", "crossings.csv"}};
+  if (!scene_.spec.splash) {
+    f.push_back({"gas against weight by height", "gas_forces.csv"});
+    f.push_back({"grains below the erosion plane at the end", "below_end.csv"});
+  }
+  return f;
 }
 
 std::string PlumeRun::result_line(const Model& m, const State& s, const RunReport& rep) const {

@@ -13,6 +13,7 @@
 
 #include "regolith_twin/run/scene.hpp"
 #include "regolith_twin/scenes/plume/erosion.hpp"
+#include "regolith_twin/scenes/plume/gas_budget.hpp"
 
 namespace rt {
 
@@ -56,16 +57,19 @@ class PlumeScene : public Scene {
 class PlumeRun : public SceneRun {
  public:
   PlumeRun(const PlumeScene& scene, const Model& m);
-  std::vector<Observer*> observers() override { return {&erosion_}; }
+  // The impulse bookkeeping reads the planes the step used: before the erosion observer moves them.
+  std::vector<Observer*> observers() override { return {&impulse_, &erosion_}; }
   void write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
                      int threads) const override;
   void write_files(const std::string& dir, const Model& m, const State& s, const RunReport& rep) const override;
   std::vector<std::pair<std::string, std::string>> files() const override;
   std::string result_line(const Model& m, const State& s, const RunReport& rep) const override;
   const ErosionObserver& erosion() const { return erosion_; }
+  const ImpulseObserver& impulse() const { return impulse_; }
 
  private:
   const PlumeScene& scene_;
+  ImpulseObserver impulse_;
   ErosionObserver erosion_;
 };
 

@@ -342,6 +342,97 @@ bool WaveAttenuation::after_step(Model& m, State& s) {
   return false;
 }
 
+namespace {
+
+// Least-squares line y = a + s x over points [i, j) of xs, ys; its squared residual.
+struct Line {
+  double slope = kNaN, intercept = kNaN, sse = kNaN;
+};
+
+Line fit_line(const std::vector<double>& xs, const std::vector<double>& ys, size_t i, size_t j) {
+  Line l;
+  if (j < i + 2) return l;
+  const double n = double(j - i);
+  double mx = 0, my = 0;
+  for (size_t q = i; q < j; ++q) mx += xs[q], my += ys[q];
+  mx /= n;
+  my /= n;
+  double cxx = 0, cxy = 0;
+  for (size_t q = i; q < j; ++q) {
+    cxx += (xs[q] - mx) * (xs[q] - mx);
+    cxy += (xs[q] - mx) * (ys[q] - my);
+  }
+  l.slope = cxy / cxx;
+  l.intercept = my - l.slope * mx;
+  l.sse = 0;
+  for (size_t q = i; q < j; ++q) {
+    const double r = ys[q] - l.intercept - l.slope * xs[q];
+    l.sse += r * r;
+  }
+  return l;
+}
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+void fit_wave_profile(WaveProfile& w, double bin) {
+  constexpr size_t kMinRun = 3;  // bins in each piece of the front search
+  w.signal_end = w.front_bin = w.last_bin = -1;
+  w.front_found = false;
+  w.front = w.break_ratio = w.precursor_median = w.precursor_max = w.slope = w.intercept = kNaN;
+  w.used.clear();
+  w.precursor.clear();
+  std::vector<int> sig;           // bins above the floor from first_bin on
+  std::vector<double> xs, ys;     // their ln d_mid, ln v_max
+  for (int k = std::max(0, w.first_bin); k < int(w.max_speed.size()); ++k)
+    if (w.max_speed[k] > w.floor && w.max_speed[k] > 0) {
+      sig.push_back(k);
+      xs.push_back(std::log((k + 0.5) * bin));
+      ys.push_back(std::log(w.max_speed[k]));
+    }
+  if (sig.empty()) return;
+  w.signal_end = sig.back();
+  size_t cut = sig.size();  // bins [0, cut) of sig are the wave
+  if (sig.size() >= 2 * kMinRun) {
+    const Line one = fit_line(xs, ys, 0, sig.size());
+    size_t best = 0;
+    double best_sse = std::numeric_limits<double>::infinity();
+    for (size_t j = kMinRun; j + kMinRun <= sig.size(); ++j) {
+      const double e = fit_line(xs, ys, 0, j).sse + fit_line(xs, ys, j, sig.size()).sse;
+      if (e < best_sse) best_sse = e, best = j;
+    }
+    // One line's residual at rounding level: a power law, nothing to cut.
+    w.break_ratio = one.sse > 1e-20 * double(sig.size()) ? best_sse / one.sse : 1.0;
+    const Line in = fit_line(xs, ys, 0, best);
+    std::vector<double> outer;
+    for (size_t q = best; q < sig.size(); ++q) outer.push_back(w.max_speed[sig[q]]);
+    const double at_front = std::exp(in.intercept + in.slope * xs[best - 1]);
+    if (w.break_ratio < 0.5 && median_of(outer) < at_front) {
+      cut = best;
+      w.front_found = true;
+    }
+  }
+  w.front_bin = w.last_bin = sig[cut - 1];
+  w.front = (w.front_bin + 1) * bin;
+  w.used.assign(sig.begin(), sig.begin() + cut);
+  w.precursor.assign(sig.begin() + cut, sig.end());
+  if (!w.precursor.empty()) {
+    std::vector<double> pv;
+    for (int k : w.precursor) pv.push_back(w.max_speed[k]);
+    w.precursor_median = median_of(pv);
+    w.precursor_max = *std::max_element(pv.begin(), pv.end());
+  }
+  const Line fit = fit_line(xs, ys, 0, cut);
+  w.slope = fit.slope;
+  w.intercept = fit.intercept;
+}
+
 void WaveAttenuation::capture(const Model& m, const State& s, double t) {
   WaveProfile w;
   w.t = t;
@@ -362,35 +453,9 @@ void WaveAttenuation::capture(const Model& m, const State& s, double t) {
     w.max_speed[k] = std::max(w.max_speed[k], s.vel[i].norm());
     w.grains[k]++;
   }
-  w.front = p >= 0 ? (s.pos[p] - opt_.impact).norm() + m.grain_radius[p] : 0.0;
-  w.first_bin = int(w.front / opt_.bin) + 1;
-  for (int k = int(w.max_speed.size()) - 1; k >= w.first_bin; --k)
-    if (w.max_speed[k] > w.floor) {
-      w.last_bin = k;
-      break;
-    }
-  std::vector<double> xs, ys;  // ln d_mid, ln v_max of the bins fitted
-  for (int k = w.first_bin; k <= w.last_bin; ++k) {
-    if (!(w.max_speed[k] > w.floor) || !(w.max_speed[k] > 0)) continue;
-    w.used.push_back(k);
-    xs.push_back(std::log((k + 0.5) * opt_.bin));
-    ys.push_back(std::log(w.max_speed[k]));
-  }
-  w.slope = w.intercept = kNaN;
-  if (xs.size() >= 2) {
-    const double n = double(xs.size());
-    double mx = 0, my = 0;
-    for (size_t q = 0; q < xs.size(); ++q) mx += xs[q], my += ys[q];
-    mx /= n;
-    my /= n;
-    double cxx = 0, cxy = 0;
-    for (size_t q = 0; q < xs.size(); ++q) {
-      cxx += (xs[q] - mx) * (xs[q] - mx);
-      cxy += (xs[q] - mx) * (ys[q] - my);
-    }
-    w.slope = cxy / cxx;
-    w.intercept = my - w.slope * mx;
-  }
+  w.contact = p >= 0 ? (s.pos[p] - opt_.impact).norm() + m.grain_radius[p] : 0.0;
+  w.first_bin = int(w.contact / opt_.bin) + 1;
+  fit_wave_profile(w, opt_.bin);
   profiles_.push_back(std::move(w));
 }
 
@@ -400,15 +465,22 @@ void WaveAttenuation::summary(JsonObject& out) const {
   for (size_t q = 0; q < profiles_.size(); ++q) {
     const WaveProfile& w = profiles_[q];
     JsonObject c;
-    std::vector<double> dist, used, grains;
+    std::vector<double> dist, used, pre, grains;
     for (size_t k = 0; k < w.max_speed.size(); ++k) {
       dist.push_back((k + 0.5) * opt_.bin);
       grains.push_back(double(w.grains[k]));
     }
     for (int k : w.used) used.push_back(double(k));
+    for (int k : w.precursor) pre.push_back(double(k));
     c.num("t", w.t).num("t_actual", w.t_actual).num("slope", w.slope).num("intercept", w.intercept);
-    c.num("front", w.front).num("floor", w.floor).num("first_bin", w.first_bin).num("last_bin", w.last_bin);
-    c.nums("bins_used", used).nums("distance", dist).nums("max_speed", w.max_speed).nums("grains", grains);
+    c.num("contact", w.contact).num("floor", w.floor);
+    c.num("first_bin", w.first_bin).num("last_bin", w.last_bin);
+    c.num("fit_from", w.first_bin * opt_.bin).num("fit_to", w.last_bin >= 0 ? (w.last_bin + 1) * opt_.bin : kNaN);
+    c.num("front", w.front).num("front_bin", w.front_bin).str("front_method", w.front_found ? "break" : "signal_end");
+    c.num("break_ratio", w.break_ratio).num("signal_end", w.signal_end);
+    c.num("precursor_median", w.precursor_median).num("precursor_max", w.precursor_max);
+    c.nums("bins_used", used).nums("precursor_bins", pre);
+    c.nums("distance", dist).nums("max_speed", w.max_speed).nums("grains", grains);
     o.obj("t" + std::to_string(q), c);
   }
   out.obj("wave", o);
@@ -416,12 +488,13 @@ void WaveAttenuation::summary(JsonObject& out) const {
 
 void WaveAttenuation::write_csv(const std::string& path) const {
   std::ostringstream f = csv_text();
-  f << "t,bin,distance_from,distance_to,distance_mid,max_speed,grains,in_fit\n";
+  f << "t,bin,distance_from,distance_to,distance_mid,max_speed,grains,in_fit,precursor\n";
   for (const WaveProfile& w : profiles_)
     for (size_t k = 0; k < w.max_speed.size(); ++k) {
       const bool in = std::find(w.used.begin(), w.used.end(), int(k)) != w.used.end();
+      const bool pre = std::find(w.precursor.begin(), w.precursor.end(), int(k)) != w.precursor.end();
       f << w.t_actual << ',' << k << ',' << k * opt_.bin << ',' << (k + 1) * opt_.bin << ',' << (k + 0.5) * opt_.bin
-        << ',' << w.max_speed[k] << ',' << w.grains[k] << ',' << int(in) << '\n';
+        << ',' << w.max_speed[k] << ',' << w.grains[k] << ',' << int(in) << ',' << int(pre) << '\n';
     }
   write_file(path, f.str());
 }

@@ -383,7 +383,7 @@ TEST(WaveAttenuation, MaxSpeedProfileAndPowerLawSlope) {
     const rt::WaveProfile& w = wave.profiles()[q];
     EXPECT_NEAR(w.t, q ? 3e-5 : 1e-5, 1e-18);
     EXPECT_NEAR(w.t_actual, q ? 3e-5 : 1.01e-5, 1e-15);
-    EXPECT_NEAR(w.front, 7e-3, 1e-12);
+    EXPECT_NEAR(w.contact, 7e-3, 1e-12);
     EXPECT_NEAR(w.floor, 1e-4, 1e-18);
     ASSERT_EQ(w.max_speed.size(), size_t(bins));
     for (int k = 0; k < bins; ++k) EXPECT_EQ(w.grains[k], 2) << k;
@@ -391,6 +391,9 @@ TEST(WaveAttenuation, MaxSpeedProfileAndPowerLawSlope) {
     EXPECT_NEAR(w.max_speed[4], As[q] * std::pow(4.5 * bin, -ns[q]), 1e-12 * w.max_speed[4]);
     EXPECT_EQ(w.first_bin, 3);
     EXPECT_EQ(w.last_bin, 12);
+    EXPECT_FALSE(w.front_found);  // an exact power law: no precursor, the front is the last bin above the floor
+    EXPECT_EQ(w.front_bin, 12);
+    EXPECT_TRUE(w.precursor.empty());
     EXPECT_EQ(w.used, (std::vector<int>{3, 4, 5, 6, 7, 8, 10, 11, 12}));
     EXPECT_NEAR(w.slope, -ns[q], 1e-10);
     EXPECT_NEAR(w.intercept, std::log(As[q]), 1e-9);
@@ -400,9 +403,9 @@ TEST(WaveAttenuation, MaxSpeedProfileAndPowerLawSlope) {
   const std::vector<std::string> lines = lines_of(path);
   std::remove(path.c_str());
   ASSERT_EQ(lines.size(), 1u + 2 * bins);
-  EXPECT_EQ(lines[0], "t,bin,distance_from,distance_to,distance_mid,max_speed,grains,in_fit");
-  EXPECT_EQ(lines[4].substr(lines[4].rfind(',')), ",1");   // bin 3
-  EXPECT_EQ(lines[10].substr(lines[10].rfind(',')), ",0");  // bin 9
+  EXPECT_EQ(lines[0], "t,bin,distance_from,distance_to,distance_mid,max_speed,grains,in_fit,precursor");
+  EXPECT_EQ(lines[4].substr(lines[4].size() - 4), ",1,0");   // bin 3
+  EXPECT_EQ(lines[10].substr(lines[10].size() - 4), ",0,0");  // bin 9
 }
 
 // One grain at the centre of every 2.5 mm cell of the default region (4-10 cm

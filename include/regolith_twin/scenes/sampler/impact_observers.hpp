@@ -9,6 +9,7 @@
 // comparison. Pass a clock that outlives the observer.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -167,6 +168,8 @@ class EnergyPartition : public Observer {
 
 // --- wave attenuation --------------------------------------------------------------------
 
+constexpr double kWaveNaN = std::numeric_limits<double>::quiet_NaN();
+
 struct WaveOptions {
   Vec3 impact = Vec3::Zero();            // impact point on the surface, m
   std::vector<double> times = {1.2e-5, 6.2e-5};  // s after impact
@@ -176,28 +179,47 @@ struct WaveOptions {
   double floor_factor = 10;              // noise floor = floor_factor * rest_rms
 };
 
-// One capture: the largest grain speed per distance bin in the cone, and the
-// power-law fit over the bins ahead of the projectile.
+// One capture: the largest grain speed per distance bin in the cone, the
+// wave front and the power-law fit over the bins from the projectile out to
+// the front (docs/scenes.md B.4).
 struct WaveProfile {
   double t = 0;                // s after impact, asked
   double t_actual = 0;         // s after impact of the step captured
   std::vector<double> max_speed;  // per bin k = [k bin, (k+1) bin), m/s (0 if empty)
   std::vector<int> grains;        // grains per bin
-  double front = 0;            // distance of the projectile's far side from the impact point, m
+  double contact = 0;          // distance of the projectile's far side from the impact point, m
   double floor = 0;            // noise floor, m/s
-  int first_bin = 0, last_bin = -1;  // fitted range
-  std::vector<int> used;       // bins in the fit
-  double slope = 0, intercept = 0;  // ln v = intercept + slope ln d (NaN with fewer than 2 bins)
+  int first_bin = 0;           // first bin wholly beyond the projectile: the fit's first bin
+  int signal_end = -1;         // last bin above the floor (-1: none)
+  bool front_found = false;    // a break was found (else the front is the signal end)
+  int front_bin = -1;          // last bin of the wave (-1: none)
+  double front = kWaveNaN;     // outer edge of the front bin, (front_bin + 1) bin, m
+  double break_ratio = kWaveNaN;  // least squares of the two pieces over that of one line (NaN: no search)
+  int last_bin = -1;           // last bin of the fit (the front bin)
+  std::vector<int> used;       // bins in the fit: first_bin..last_bin above the floor
+  std::vector<int> precursor;  // bins above the floor beyond the front
+  double precursor_median = kWaveNaN, precursor_max = kWaveNaN;  // of their max speeds, m/s
+  double slope = kWaveNaN, intercept = kWaveNaN;  // ln v = intercept + slope ln d (NaN with fewer than 2 bins)
 };
+
+// The front and the fit of a profile whose max_speed, floor and first_bin are
+// set (bins of width `bin`, m): the bins from first_bin on above the floor are
+// the signal, up to the last one (signal_end). With at least six, they are cut
+// into an inner and an outer run of at least three bins each where two
+// straight lines fitted by least squares to (ln d_mid, ln v_max), one per
+// run, leave the least squared residual; the cut is the front if it leaves
+// less than half the residual of one line over all of them and the outer
+// run's median max speed is below the inner line at the last inner bin (a drop
+// to a slower precursor). Otherwise the front is the signal end and there is
+// no precursor. The power law is then fitted over first_bin..front_bin.
+void fit_wave_profile(WaveProfile& w, double bin);
 
 // At each time after impact (at the first step at or after it), for the bed
 // grains (not the projectile) in the downward cone of the given half-apex
 // angle with its apex at the impact point: the largest speed in each bin of
-// distance from the impact point. The power law v ∝ d^slope is fitted by
-// least squares on (ln d_mid, ln v_max) over the bins from the first one
-// entirely beyond the projectile (its centre's distance plus its radius) to
-// the last bin above the noise floor; bins in between that are empty or not
-// above the floor are left out.
+// distance from the impact point, fitted by fit_wave_profile from the first
+// bin entirely beyond the projectile (its centre's distance plus its radius)
+// to the wave front.
 class WaveAttenuation : public Observer {
  public:
   WaveAttenuation(const ImpactClock* clock, const WaveOptions& opt);
@@ -208,7 +230,7 @@ class WaveAttenuation : public Observer {
   double rest_rms() const { return rest_rms_; }
   const std::vector<WaveProfile>& profiles() const { return profiles_; }  // captured so far, in time order
   // wave.csv: t (s after impact, captured), bin, distance from and to, mid
-  // distance (m), max speed (m/s), grains, in_fit (0/1).
+  // distance (m), max speed (m/s), grains, in_fit (0/1), precursor (0/1).
   void write_csv(const std::string& path) const;
 
  private:

@@ -1,14 +1,17 @@
 #!/usr/bin/python3
 """Plume-erosion campaign (docs/scenes.md D, docs/validation.md "Plume erosion").
 
-  plume_campaign.py BIN OUT DOCS calibrate        bisection on the gas scale u0 (seed 1)
+  plume_campaign.py BIN OUT DOCS calibrate        bisection on the gas profile's scale (seed 1)
   plume_campaign.py BIN OUT DOCS run [RUN...]     runs (default: all), each seed in turn
   plume_campaign.py BIN OUT DOCS report           docs/validation/plume/report.md + plots
+  plume_campaign.py BIN OUT DOCS mechanism DIR... the mechanism figures of run folders (crossings.csv, ...)
 
-A finished run's summary.json and its N(t) every millisecond are copied to
-DOCS/RUN/ (committed: a campaign resumes on any machine; a run whose copy
-exists is not run again unless PLUME_RERUN=1); a run that stopped leaves
-DOCS/RUN/failed.txt (its exit and last lines), reported and not retried.
+A finished run's summary.json, its N(t) every millisecond, and its
+crossings.csv, below_end.csv and gas_forces.csv (docs/scenes.md D,
+"Measurements of the mechanism") are copied to DOCS/RUN/ (committed: a
+campaign resumes on any machine; a run whose copy exists is not run again
+unless PLUME_RERUN=1); a run that stopped leaves DOCS/RUN/failed.txt (its
+exit and last lines), reported and not retried.
 """
 import csv
 import json
@@ -21,6 +24,11 @@ import campaign_cli  # noqa: E402
 CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "plume_erosion.yaml")
 SEEDS = [1, 2, 3]
 MAT = ["materials.regolith", "materials.floor"]
+# The gas profile's one calibrated scale (docs/scenes.md D): U(h) = u_log ln(1 + h / d) above the
+# anchoring plane, zero at the plane. `calibrate` bisects on `key` between `bounds` with `fixed` set.
+PROFILE = {"what": "U(h) = u_log ln(1 + h/d), U(0) = 0", "key": "gas.u_log", "symbol": "u_log",
+           "fixed": ["gas.u0=0", "gas.h_log=0.001", "gas.shear=0"], "bounds": (4.0, 40.0)}
+KEEP = ("crossings.csv", "below_end.csv", "gas_forces.csv")
 
 
 def both(key, value):
@@ -62,7 +70,7 @@ def run_one(bin_dir, out, docs, name, seed, extra=(), tag=None):
         return None if s == "failed" else s
     overrides = (list(RUNS[name][0]) if name in RUNS else []) + list(extra) + ["seed=%d" % seed]
     d = os.path.join(out, tag)
-    s = campaign_cli.run_and_keep(bin_dir, CONFIG, d, keep, overrides, {"run": name, "seed": seed})
+    s = campaign_cli.run_and_keep(bin_dir, CONFIG, d, keep, overrides, {"run": name, "seed": seed}, copies=KEEP)
     if s is None:
         return None
     with open(os.path.join(d, "erosion.csv")) as f, open(os.path.join(keep, "n_of_t.csv"), "w") as g:
@@ -86,18 +94,18 @@ def line(s):
 
 
 def calibrate(bin_dir, out, docs):
-    """Bisection on u0 (u_log = 0.3 u0) for depletion at 0.15 s on seed 1."""
-    target, lo, hi = 0.15, 8.0, 24.0
+    """Bisection on the profile's scale (PROFILE) for depletion at 0.15 s on seed 1."""
+    target, (lo, hi) = 0.15, PROFILE["bounds"]
     steps = []
 
     def t_dep(u):
-        tag = "cal_u%.4g" % u
+        tag = "cal_%s%.4g" % (PROFILE["symbol"], u)
         s = run_one(bin_dir, out, os.path.join(docs, "calibration"), "base", 1,
-                    ["gas.u0=%.6g" % u, "gas.u_log=%.6g" % (0.3 * u), "plume.duration=0.25"], tag)
+                    PROFILE["fixed"] + ["%s=%.6g" % (PROFILE["key"], u), "plume.duration=0.25"], tag)
         if s is None:
             raise SystemExit("calibration run %s failed" % tag)
         t = s["observers"]["erosion"]["depleted_at"]
-        steps.append({"u0": u, "depleted_at": t})
+        steps.append({"scale": u, "depleted_at": t})
         return t if t >= 0 else 1e9
 
     for _ in range(7):
@@ -107,11 +115,12 @@ def calibrate(bin_dir, out, docs):
         else:
             hi = mid
     best = min(steps, key=lambda x: abs(x["depleted_at"] - target))
-    res = {"target_depleted_at": target, "steps": steps, "u0": best["u0"], "u_log": 0.3 * best["u0"]}
+    res = {"target_depleted_at": target, "profile": PROFILE["what"], "key": PROFILE["key"],
+           "symbol": PROFILE["symbol"], "fixed": PROFILE["fixed"], "steps": steps, "scale": best["scale"]}
     with open(os.path.join(docs, "calibration.json"), "w") as f:
         json.dump(res, f, indent=1)
-    print("calibrated: u0 = %.4g m/s (depleted at %.4g s); set gas.u0 and gas.u_log in %s" %
-          (best["u0"], best["depleted_at"], CONFIG))
+    print("calibrated: %s = %.4g (depleted at %.4g s); set it in %s" %
+          (PROFILE["key"], best["scale"], best["depleted_at"], CONFIG))
 
 
 def main():
@@ -127,6 +136,12 @@ def main():
     elif cmd == "report":
         import plume_report
         plume_report.report(docs, RUNS)
+    elif cmd == "mechanism":
+        import plume_report
+        for d in names:
+            m = plume_report.mechanism(d) or {}
+            m.pop("series", None)
+            print(d, json.dumps(m, indent=1))
     else:
         raise SystemExit(__doc__)
 

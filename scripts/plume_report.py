@@ -61,6 +61,73 @@ def n_of_t(d):
     return t, n, touch
 
 
+def _rows(path):
+    with open(path) as f:
+        return list(csv.DictReader(x for x in f if not x.startswith("#")))
+
+
+def mechanism(d):
+    """Figures of one run folder from its crossings.csv, series.csv (or n_of_t.csv) and below_end.csv
+    (docs/scenes.md D, "Measurements of the mechanism"); None without crossings.csv."""
+    p = os.path.join(d, "crossings.csv")
+    if not os.path.exists(p):
+        return None
+    rs = _rows(p)
+    out = {"crossings": len(rs)}
+    if rs:
+        col = lambda k: [float(r[k]) for r in rs]  # noqa: E731
+        mean = lambda xs: sum(xs) / len(xs)  # noqa: E731
+        for k in ("v_start", "v", "dv_gas", "dv_contact", "dv_gravity", "since", "ascent", "ascent_dv_gas",
+                  "ascent_dv_contact", "ascent_dv_gravity"):
+            out[k] = mean(col(k))
+        ag, ac = col("ascent_dv_gas"), col("ascent_dv_contact")
+        out["ascent_gas_share"] = sum(ag) / (sum(ag) + sum(ac)) if sum(ag) + sum(ac) else float("nan")
+        out["ascent_gas_above_contact"] = mean([1.0 if g > c else 0.0 for g, c in zip(ag, ac)])
+        ml = sorted(col("ascent_max_lift"))
+        out["ascent_max_lift_median"] = ml[len(ml) // 2]
+        out["ascent_max_lift_max"] = ml[-1]
+        out["ascent_lift_above_weight"] = mean([1.0 if x > 1 else 0.0 for x in ml])
+    p = os.path.join(d, "below_end.csv")
+    if os.path.exists(p):
+        b = _rows(p)
+        out["below_end"] = len(b)
+        if b:
+            out["below_z_d"] = sum(float(r["z_d"]) for r in b) / len(b)
+            out["below_vx"] = sum(float(r["vx"]) for r in b) / len(b)
+            out["below_vx_over_u"] = sum(float(r["vx"]) / float(r["u"]) for r in b if float(r["u"]) > 0) / len(b)
+            out["below_lift"] = sum(float(r["gas_z_over_weight"]) for r in b) / len(b)
+            out["below_lift_max"] = max(float(r["gas_z_over_weight"]) for r in b)
+    p = os.path.join(d, "series.csv")
+    if os.path.exists(p):
+        s = _rows(p)
+        if s and "bed_vx" in s[0]:
+            out["series"] = [{k: float(r[k]) for k in ("t", "above", "bed_vx", "floor_layer_vx", "lifted_vx",
+                                                      "surface_layer_lift", "surface_layer_lift_max")}
+                             for r in s]
+    return out
+
+
+def mechanism_lines(docs, names):
+    """Markdown table of the mechanism figures of the kept runs `names` (those with crossings.csv)."""
+    runs = runs_of(docs)
+    lines = ["| run | seed | crossings | v_z at the surface (m/s) | gas / contacts / gravity above the surface (m/s) | "
+             "ascent (ms) | gas / contacts / gravity over the ascent (m/s) | gas share of the ascent's push | "
+             "ascents with lift > weight | median / largest lift over weight in an ascent |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for name in names:
+        for seed, s, d in sorted(runs.get(name, []), key=lambda x: x[0]):
+            m = mechanism(d)
+            if not m or not m["crossings"]:
+                continue
+            lines.append("| %s | %d | %d | %.3f | %.4f / %.4f / %.4f | %.1f | %.4f / %.4f / %.4f | %.2f | %.2f | "
+                         "%.2f / %.2f |" % (
+                             name, seed, m["crossings"], m["v_start"], m["dv_gas"], m["dv_contact"],
+                             m["dv_gravity"], 1e3 * m["ascent"], m["ascent_dv_gas"], m["ascent_dv_contact"],
+                             m["ascent_dv_gravity"], m["ascent_gas_share"], m["ascent_lift_above_weight"],
+                             m["ascent_max_lift_median"], m["ascent_max_lift_max"]))
+    return lines
+
+
 def plot_groups(runs, groups, path, title):
     fig, ax = plt.subplots(figsize=(7, 4.2))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
@@ -115,6 +182,14 @@ def report(docs, RUNS):
             name, what, len(rs), len(seeds), fmt(*rate), fmt(*area), dep_txt, up[0], down[0], fmt(*pairs),
             fmt(*mean_sd(touch)), wall[0]))
     lines += campaign_cli.failure_lines(docs)
+    mech = mechanism_lines(docs, [n for n in RUNS if n != "splash"])
+    if len(mech) > 2:
+        lines += ["", "Where the grains crossing the erosion plane get their upward velocity (crossings.csv of each "
+                  "run; docs/scenes.md D, \"Measurements of the mechanism\"): means over the crossings of v_z when "
+                  "the grain's centre was last below the surface, the impulses over its mass from the gas, the "
+                  "contacts and gravity since then, and over its last ascent (since its v_z was last <= 0); the "
+                  "gas's share of the ascent's gas + contact impulse; the ascents in which the lift exceeded the "
+                  "weight at some step.", ""] + mech
     lines += ["", "Published statements each run can be compared with (Berger et al. 2013):", ""]
     for k, v in PUBLISHED.items():
         lines.append("- `%s`%s: %s" % (k, " (every ε–μ run)" if k == "e" else "", v))
@@ -153,12 +228,13 @@ def report(docs, RUNS):
     cal = os.path.join(docs, "calibration.json")
     if os.path.exists(cal):
         c = json.load(open(cal))
-        lines += ["", "Calibration (seed 1, bisection on u0 with u_log = 0.3 u0, target depletion at %.3g s):" %
-                  c["target_depleted_at"], "", "| u0 (m/s) | depleted at (s) |", "|---|---|"]
-        for st in c["steps"]:
-            lines.append("| %.4g | %.4g |" % (st["u0"], st["depleted_at"]))
+        lines += ["", "Calibration (seed 1, bisection on %s of %s, target depletion at %.3g s; -1: not depleted "
+                  "within the run):" % (c["symbol"], c["profile"], c["target_depleted_at"]), "",
+                  "| %s (m/s) | depleted at (s) |" % c["symbol"], "|---|---|"]
+        for st in sorted(c["steps"], key=lambda x: x["scale"]):
+            lines.append("| %.4g | %.4g |" % (st["scale"], st["depleted_at"]))
         lines.append("")
-        lines.append("Chosen: u0 = %.4g m/s, u_log = %.4g m/s." % (c["u0"], c["u_log"]))
+        lines.append("Chosen: %s = %.4g m/s." % (c["symbol"], c["scale"]))
     with open(os.path.join(docs, "report.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("plume report: %s" % os.path.join(docs, "report.md"))

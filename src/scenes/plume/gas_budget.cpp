@@ -222,7 +222,7 @@ void ImpulseObserver::write_csv(const std::string& path) const {
        "its mass (m/s), the largest lift over weight during it; v = ascent_v_start + the three ascent impulses\n";
   f << "t,grain,since,v_start,v,dv_gas,dv_contact,dv_gravity,ascent,ascent_v_start,ascent_dv_gas,ascent_dv_contact,"
        "ascent_dv_gravity,ascent_max_lift\n";
-  f.precision(9);
+  f.precision(6);
   for (const ImpulseRecord& r : records_)
     f << r.t << ',' << r.grain << ',' << r.since << ',' << r.v_start << ',' << r.v << ',' << r.dv_gas << ','
       << r.dv_contact << ',' << r.dv_gravity << ',' << r.ascent << ',' << r.ascent_v_start << ','

@@ -60,14 +60,28 @@ def main():
               f"{e['initial_energy']:.4g} | {e['ke_bed_trans']:.4f} | {e['ke_bed_rot']:.4f} | {proj:.4f} | "
               f"{el:.4f} | {1 - e['total']:.4f} |")
     print()
-    print("Wave attenuation: slope of log(largest grain speed) against log(distance) from the impact point:")
+    print("Wave attenuation: slope of log(largest grain speed) against log(distance) from the impact point, "
+          "fitted from the first bin beyond the projectile out to the wave front (docs/scenes.md B.4); runs "
+          "from before the front search (no front method) were fitted through the precursor out to the last "
+          "bin above the noise floor:")
     print()
-    print("| run | time after impact s | slope | front m |")
-    print("|---|---|---|---|")
+    print("| run | time after impact s | slope | fitted bins (mm) | front mm (how) | precursor bins, median m/s |")
+    print("|---|---|---|---|---|---|")
     for n, s in runs.items():
         w = s["observers"].get("wave", {})
         for k in sorted(k for k in w if isinstance(w[k], dict)):
-            print(f"| {n} | {w[k]['t']:.3g} | {g(w[k].get('slope'), '{:.2f}')} | {g(w[k].get('front'))} |")
+            c = w[k]
+            if "front_method" in c:
+                used = c.get("bins_used", [])
+                fitted = (f"{used[0]:.0f}–{used[-1]:.0f} ({1e3 * c['fit_from']:.1f}–{1e3 * c['fit_to']:.1f})"
+                          if used else "–")
+                front = "–" if c.get("front") is None else f"{1e3 * c['front']:.1f} ({c['front_method']})"
+                pre = c.get("precursor_bins", [])
+                pre = f"{len(pre)}, {c['precursor_median']:.2g}" if pre else "none"
+            else:
+                fitted = f"{c['first_bin']:.0f}–{c['last_bin']:.0f} (through the precursor)"
+                front, pre = "–", "–"
+            print(f"| {n} | {c['t']:.3g} | {g(c.get('slope'), '{:.2f}')} | {fitted} | {front} | {pre} |")
     print()
     print("Z-model (Maxwell) fits of the grain velocity field, flow centre at the impact point (fixed H0) "
           "and fitted:")

@@ -3,7 +3,9 @@
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BUILD=${REGOLITH_BUILD:-$ROOT/build}
-BIN=$BUILD/devel/lib/regolith_twin
+# REGOLITH_BIN=DIR: run the tools in DIR (a copy of the binaries, so that a long campaign is not
+# changed by a rebuild under it) and build nothing.
+BIN=${REGOLITH_BIN:-$BUILD/devel/lib/regolith_twin}
 # ROS and catkin tools run with the system interpreter, not a pyenv one.
 export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
 # Waiting OpenMP threads sleep instead of spinning: spinning threads starve
@@ -57,6 +59,7 @@ need_slurm() {
 # Configure and build everything (library, tools, tests) out of source.
 build_all() {
   need_packages "${BUILD_PACKAGES[@]}"
+  [ -n "${REGOLITH_BIN:-}" ] && return 0
   local jobs
   mkdir -p "$BUILD"
   jobs=$(nproc 2>/dev/null || echo 2)

@@ -24,6 +24,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib
 import campaign_cli  # noqa: E402
 
 CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "incline_moderate.yaml")
+DOCS_DEFAULT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "validation", "incline")
 RAIN_CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "incline_rain.yaml")
 # The published protocol at fixed angles 1 degree apart around the published onsets (gravel 39-40,
 # moderate 30-31 deg); each run 8 s, judged over its last 2 s (config/incline_rain.yaml).
@@ -164,6 +165,60 @@ def rain_onset(done, m):
     return onset, rows
 
 
+STEADY_CHANGE = 0.05  # a rain run's flow counts as steady if its mean speed changes by less than this fraction
+                      # over the averaging window (|dV/dt| window < 0.05 V)
+
+
+def top_layer_inertial_number(profile_rows, h, phi, theta_deg, d, g=9.81):
+    """I of the top layer of a flow (the published definition: the shear of the top layer):
+    I = gamma_dot d / sqrt(P / rho_p), gamma_dot the velocity difference of the two highest 1 cm layers
+    wholly below the surface h over their distance, P / rho_p = Phi g cos theta (h - z) at their middle.
+    profile_rows: (z, v_x) of the layers (centres above the base). None if the flow has no two layers."""
+    rows = sorted(profile_rows)
+    if len(rows) < 2:
+        return None
+    dz = rows[1][0] - rows[0][0]
+    inside = [(z, v) for z, v in rows if z + 0.5 * dz <= h + 1e-12]
+    if len(inside) < 2:
+        return None
+    (z1, v1), (z2, v2) = inside[-2], inside[-1]
+    zm = 0.5 * (z1 + z2)
+    gamma = (v2 - v1) / (z2 - z1)
+    return gamma * d / math.sqrt(phi * g * math.cos(math.radians(theta_deg)) * (h - zm))
+
+
+def rain_points(done, docs, m):
+    """(angle, I of the top layer, mu = tan theta, steady) of a material's flowing rain runs."""
+    pts = []
+    for a in RAIN[m]:
+        n = rain_run(m, a)
+        if n not in done:
+            continue
+        o = done[n]["observers"]["incline"]
+        if not o["flowing"]:
+            continue
+        prof = os.path.join(docs, n, "profile.csv")
+        if not os.path.exists(prof):
+            continue
+        rows = [(float(r.split(",")[0]), float(r.split(",")[1])) for r in open(prof) if r[0].isdigit()]
+        i = top_layer_inertial_number(rows, o["flow_height"], o["packing_mean"], o["theta_deg"],
+                                      done[n]["bed"]["diameter"])
+        steady = abs(o["end_dvdt"]) * 2.0 < STEADY_CHANGE * abs(o["end_mean_vx"])
+        pts.append((a, i, math.tan(math.radians(a)), steady))
+    return pts
+
+
+def steady_fit(done, m, docs=None):
+    """mu(I) = mu_s + (mu_2 - mu_s) / (I0 / I + 1) fitted to a material's steady rain flows (mu = tan theta,
+    I of the top layer): (mu_s, mu_2, I0) when at least 4 steady flows give a resolved fit, else None."""
+    docs = docs or DOCS_DEFAULT
+    pts = [(i, mu) for _, i, mu, st in rain_points(done, docs, m) if st and i and i > 0]
+    if len(pts) < 4:
+        return None
+    mu1, mu2, i0, _ = fit_mu_i(pts)
+    return (mu1, mu2, i0) if fit_resolved(mu1, mu2, i0) else None
+
+
 def window_of(name):
     """The averaging window (s) of a fixed-angle run."""
     return WINDOW[name]
@@ -267,6 +322,17 @@ def report(docs):
         lines.append("| %s | %s | %s | %s | %d–%d° |" % (
             m, ", ".join("%g°" % r[0] for r in rows), ", ".join("%g°" % r[0] for r in rows if r[1]) or "none",
             "%g°" % onset if onset is not None else "none in the range run", *PUBLISHED_ONSET[m]))
+    lines += ["", "Flows of the published protocol (rain runs that flow): mu = tan theta, I of the top layer "
+              "(the velocity difference of the two highest 1 cm layers below the surface over their distance, "
+              "P / rho_p = Phi g cos theta (h - z)); steady: the mean speed changes by less than %g %% over the "
+              "last 2 s." % (100 * STEADY_CHANGE), "", "| material | angle | I (top layer) | mu = tan theta | steady |",
+              "|---|---|---|---|---|"]
+    for m in RAIN:
+        for a, i, mu, st in rain_points(done, docs, m):
+            lines.append("| %s | %g° | %s | %.4f | %s |" % (m, a, "%.3g" % i if i else "–", mu, "yes" if st else "no"))
+        fit = steady_fit(done, m, docs)
+        if fit:
+            lines.append("| %s: mu(I) fit | | mu_s %.4f, mu_2 %.4f, I0 %.3g | | |" % (m, *fit))
     lines += campaign_cli.failure_lines(docs)
     lines += ["", "Fitted mu(I) = mu1 + (mu2 - mu1) / (I0 / I + 1):", "",
               "| material | angles | mu1 | mu2 | I0 | rms |", "|---|---|---|---|---|---|"] + fits

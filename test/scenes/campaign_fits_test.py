@@ -83,6 +83,16 @@ class InclineFits(unittest.TestCase):
         mu = incline_campaign.base_friction(o, 0.4)
         self.assertAlmostEqual(9.81 * (math.sin(th) - mu * math.cos(th)), 0.4, delta=1e-12)
 
+    def test_top_layer_inertial_number(self):
+        # A linear profile v = 3 z (1/s) in 1 cm layers under a surface at h = 0.2 m: the top layer's shear
+        # is 3 1/s, at the middle of the two highest layers (centres 0.185 and 0.195 m), 1 cm below the surface.
+        rows = [((k + 0.5) * 0.01, 3.0 * (k + 0.5) * 0.01) for k in range(25)]
+        i = incline_campaign.top_layer_inertial_number(rows, 0.2, 0.6, 30.0, 0.01)
+        want = 3.0 * 0.01 / math.sqrt(0.6 * 9.81 * math.cos(math.radians(30)) * 0.01)
+        self.assertAlmostEqual(i, want, delta=1e-12 * want)
+        # Layers above the surface are left out; one layer is not enough.
+        self.assertIsNone(incline_campaign.top_layer_inertial_number(rows[:1], 0.2, 0.6, 30.0, 0.01))
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -87,17 +87,22 @@ TEST(InclineOnset, AStepThroughAnglesSkipsADyingSurgeAndStopsAtSustainedFlow) {
   EXPECT_NEAR(m.gravity.x(), g * std::sin(32 * kPi / 180), 1e-12);
 }
 
-TEST(InclineScene, BadInputIsRefused) {
+// Loading `file` with the overrides `set` is refused with an error naming `what`.
+void expect_refused(const std::string& file, const std::vector<std::string>& set, const std::string& what) {
   rt::SceneOptions o;
   o.quiet = true;
   o.cache_dir = ::testing::TempDir() + "/incline_cache";
-  auto refused = [&o](const std::vector<std::string>& set, const std::string& what) {
-    try {
-      rt::load_scene("config/incline_moderate.yaml", set, o);
-      ADD_FAILURE() << "accepted: " << what;
-    } catch (const rt::InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
-    }
+  try {
+    rt::load_scene(file, set, o);
+    ADD_FAILURE() << "accepted: " << what;
+  } catch (const rt::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+  }
+}
+
+TEST(InclineScene, BadInputIsRefused) {
+  auto refused = [](const std::vector<std::string>& set, const std::string& what) {
+    expect_refused("config/incline_moderate.yaml", set, what);
   };
   refused({"incline.mode=tilt"}, "incline.mode");
   refused({"incline.angle_deg=95"}, "incline.angle_deg");
@@ -203,18 +208,8 @@ TEST(InclineRain, SteepEnoughTheDepositFlows) {
 }
 
 TEST(InclineRain, BadInputIsRefused) {
-  rt::SceneOptions o;
-  o.quiet = true;
-  auto refused = [&o](const std::vector<std::string>& set, const std::string& what) {
-    try {
-      rt::load_scene("config/incline_rain.yaml", set, o);
-      ADD_FAILURE() << "accepted: " << what;
-    } catch (const rt::InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
-    }
-  };
-  refused({"grains.0.fixed=true"}, "fixed");
-  refused({"walls=[]"}, "plane floor");
+  expect_refused("config/incline_rain.yaml", {"grains.0.fixed=true"}, "fixed");
+  expect_refused("config/incline_rain.yaml", {"walls=[]"}, "plane floor");
 }
 
 }  // namespace

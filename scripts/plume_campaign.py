@@ -7,8 +7,8 @@
   plume_campaign.py BIN OUT DOCS mechanism DIR... the mechanism figures of run folders (crossings.csv, ...)
 
 A finished run's summary.json, its N(t) every millisecond, and its
-crossings.csv, below_end.csv and gas_forces.csv (docs/scenes.md D,
-"Measurements of the mechanism") are copied to DOCS/RUN/ (committed: a
+crossings.csv, below_end.csv, gas_forces.csv and series.csv (docs/scenes.md
+D, "Measurements of the mechanism") are copied to DOCS/RUN/ (committed: a
 campaign resumes on any machine; a run whose copy exists is not run again
 unless PLUME_RERUN=1); a run that stopped leaves DOCS/RUN/failed.txt (its
 exit and last lines), reported and not retried.
@@ -25,10 +25,19 @@ CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config"
 SEEDS = [1, 2, 3]
 MAT = ["materials.regolith", "materials.floor"]
 # The gas profile's one calibrated scale (docs/scenes.md D): U(h) = u_log ln(1 + h / d) above the
-# anchoring plane, zero at the plane. `calibrate` bisects on `key` between `bounds` with `fixed` set.
-PROFILE = {"what": "U(h) = u_log ln(1 + h/d), U(0) = 0", "key": "gas.u_log", "symbol": "u_log",
-           "fixed": ["gas.u0=0", "gas.h_log=0.001", "gas.shear=0"], "bounds": (4.0, 40.0)}
-KEEP = ("crossings.csv", "below_end.csv", "gas_forces.csv")
+# anchoring plane, zero at the plane. `calibrate` bisects `steps` times on `key` between `bounds`
+# with `fixed` set. PLUME_PROFILE=linear selects the linear profile of the sensitivity check
+# (docs/validation.md "Plume erosion"); PLUME_SET="key=value ..." adds overrides to every run (its
+# calibrated scale, with DOCS a folder of its own).
+PROFILES = {
+    "log": {"what": "U(h) = u_log ln(1 + h/d), U(0) = 0", "key": "gas.u_log", "symbol": "u_log", "unit": "m/s",
+            "fixed": ["gas.u0=0", "gas.h_log=0.001", "gas.shear=0"], "bounds": (4.0, 40.0), "steps": 7},
+    "linear": {"what": "U(h) = G h, U(0) = 0", "key": "gas.shear", "symbol": "G", "unit": "1/s",
+               "fixed": ["gas.u0=0", "gas.u_log=0"], "bounds": (2000.0, 8000.0), "steps": 5},
+}
+PROFILE = PROFILES[os.environ.get("PLUME_PROFILE", "log")]
+EXTRA = os.environ.get("PLUME_SET", "").split()
+KEEP = ("crossings.csv", "below_end.csv", "gas_forces.csv", "series.csv")
 
 
 def both(key, value):
@@ -68,7 +77,7 @@ def run_one(bin_dir, out, docs, name, seed, extra=(), tag=None):
     s = campaign_cli.kept(keep, "PLUME_RERUN")
     if s is not None:
         return None if s == "failed" else s
-    overrides = (list(RUNS[name][0]) if name in RUNS else []) + list(extra) + ["seed=%d" % seed]
+    overrides = EXTRA + (list(RUNS[name][0]) if name in RUNS else []) + list(extra) + ["seed=%d" % seed]
     d = os.path.join(out, tag)
     s = campaign_cli.run_and_keep(bin_dir, CONFIG, d, keep, overrides, {"run": name, "seed": seed}, copies=KEEP)
     if s is None:
@@ -108,7 +117,7 @@ def calibrate(bin_dir, out, docs):
         steps.append({"scale": u, "depleted_at": t})
         return t if t >= 0 else 1e9
 
-    for _ in range(7):
+    for _ in range(PROFILE["steps"]):
         mid = 0.5 * (lo + hi)
         if t_dep(mid) > target:
             lo = mid
@@ -116,7 +125,8 @@ def calibrate(bin_dir, out, docs):
             hi = mid
     best = min(steps, key=lambda x: abs(x["depleted_at"] - target))
     res = {"target_depleted_at": target, "profile": PROFILE["what"], "key": PROFILE["key"],
-           "symbol": PROFILE["symbol"], "fixed": PROFILE["fixed"], "steps": steps, "scale": best["scale"]}
+           "symbol": PROFILE["symbol"], "unit": PROFILE["unit"], "fixed": PROFILE["fixed"], "steps": steps,
+           "scale": best["scale"]}
     with open(os.path.join(docs, "calibration.json"), "w") as f:
         json.dump(res, f, indent=1)
     print("calibrated: %s = %.4g (depleted at %.4g s); set it in %s" %

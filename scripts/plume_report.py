@@ -259,11 +259,11 @@ def report(docs, RUNS):
         c = json.load(open(cal))
         lines += ["", "Calibration (seed 1, bisection on %s of %s, target depletion at %.3g s; -1: not depleted "
                   "within the run):" % (c["symbol"], c["profile"], c["target_depleted_at"]), "",
-                  "| %s (m/s) | depleted at (s) |" % c["symbol"], "|---|---|"]
+                  "| %s (%s) | depleted at (s) |" % (c["symbol"], c.get("unit", "m/s")), "|---|---|"]
         for st in sorted(c["steps"], key=lambda x: x["scale"]):
             lines.append("| %.4g | %.4g |" % (st["scale"], st["depleted_at"]))
         lines.append("")
-        lines.append("Chosen: %s = %.4g m/s." % (c["symbol"], c["scale"]))
+        lines.append("Chosen: %s = %.6g %s." % (c["symbol"], c["scale"], c.get("unit", "m/s")))
     with open(os.path.join(docs, "report.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("plume report: %s" % os.path.join(docs, "report.md"))

@@ -52,6 +52,16 @@ DURATION = 0.3
 ORDER = {"gb_10_5mm": [0.1, 1.0, 0.5, 0.3, 0.7, 0.8, 0.4, 0.6, 0.2, 0.9]}
 
 
+def read_json(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def read_lines(path):
+    with open(path) as f:
+        return f.readlines()
+
+
 def run_name(bed, v, aim=0):
     return "%s_v%.2f%s" % (bed, v, "_a%d" % aim if aim else "")
 
@@ -129,12 +139,12 @@ def load(docs):
         for v in SPEEDS:
             f = os.path.join(docs, run_name(bed, v), "summary.json")
             if os.path.exists(f):
-                d["sweep"].append(json.load(open(f)))
+                d["sweep"].append(read_json(f))
         for v in AIM_SPEEDS:
             for a in AIMS:
                 f = os.path.join(docs, run_name(bed, v, a), "summary.json")
                 if os.path.exists(f):
-                    d["aims"].setdefault(v, []).append(json.load(open(f)))
+                    d["aims"].setdefault(v, []).append(read_json(f))
         if d["sweep"] or d["aims"]:
             out[bed] = d
     return out
@@ -146,7 +156,7 @@ def late_sinking(docs, s):
     path = os.path.join(docs, name, "impact.csv")
     if not os.path.exists(path):
         return float("nan")
-    rows = [[float(x) for x in r.split(",")] for r in open(path) if r[0].isdigit()]
+    rows = [[float(x) for x in r.split(",")] for r in read_lines(path) if r[0].isdigit()]
     t_end = rows[-1][0]
     before = max(r[1] for r in rows if r[0] <= t_end - 0.1) if t_end > 0.1 else 0.0
     return max(r[1] for r in rows) - before

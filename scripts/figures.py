@@ -26,6 +26,16 @@ REPRO = os.path.join(ROOT, "docs", "reproduction.md")
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
 
+
+def read_text(path):
+    with open(path) as f:
+        return f.read()
+
+
+def dict_rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
 MATERIALS = ("gravel", "moderate")
 ATTITUDES = ("Flat", "BCF", "FCF")
 ANGLES = (0, 15, 30, 45, 60)
@@ -204,7 +214,7 @@ def plume():
         out["plume.%s.rate" % n] = (rates, "scripts/validate_plume run %s" % run)
     peaks, times = [], []
     for f in sorted(glob.glob(os.path.join(docs, "base_s*", "n_of_t.csv"))):
-        rows = list(csv.DictReader(open(f)))
+        rows = dict_rows(f)
         if rows and "touching_fraction" in rows[0]:
             best = max(rows, key=lambda r: float(r["touching_fraction"]))
             peaks.append(float(best["touching_fraction"]))
@@ -292,7 +302,7 @@ def sampler():
         f = os.path.join(d, "energy_partition.csv")
         if not os.path.exists(f):
             return None
-        rows = list(csv.DictReader(open(f)))
+        rows = dict_rows(f)
         best = min(rows, key=lambda r: abs(float(r["t"]) - 1.2e-4))
         return float(best["ke_bed_trans"]) + float(best["ke_bed_rot"]) if abs(float(best["t"]) - 1.2e-4) < 1e-5 \
             else None
@@ -469,7 +479,7 @@ def reproduction(rows_csv):
     summary = "%d statements: %d reproduced (✓), %d not (✗), %d not run yet (–)." % (
         sum(counts.values()), counts[True], counts[False], counts[None])
     src = os.path.join(ROOT, "docs", "reproduction.in.md")
-    text = open(src).read() if os.path.exists(src) else "# Reproduction\n\n<!-- table -->\n"
+    text = read_text(src) if os.path.exists(src) else "# Reproduction\n\n<!-- table -->\n"
     return text.replace("<!-- summary -->", summary).replace("<!-- table -->", "\n".join(out))
 
 
@@ -479,7 +489,7 @@ def main():
     page = reproduction(rows)
     if len(sys.argv) > 1 and sys.argv[1] == "--check":
         for path, want in ((OUT, text), (REPRO, page)):
-            old = open(path).read() if os.path.exists(path) else ""
+            old = read_text(path) if os.path.exists(path) else ""
             if old != want:
                 sys.stderr.write("%s is not what the committed results give: run scripts/figures.py\n" %
                                  os.path.relpath(path, ROOT))

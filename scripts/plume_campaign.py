@@ -33,7 +33,7 @@ PROFILES = {
     "log": {"what": "U(h) = u_log ln(1 + h/d), U(0) = 0", "key": "gas.u_log", "symbol": "u_log", "unit": "m/s",
             "fixed": ["gas.u0=0", "gas.h_log=0.001", "gas.shear=0"], "bounds": (4.0, 40.0), "steps": 7},
     "linear": {"what": "U(h) = G h, U(0) = 0", "key": "gas.shear", "symbol": "G", "unit": "1/s",
-               "fixed": ["gas.u0=0", "gas.u_log=0"], "bounds": (2000.0, 8000.0), "steps": 5},
+               "fixed": ["gas.u0=0", "gas.u_log=0"], "bounds": (2000.0, 6000.0), "steps": 5},
 }
 PROFILE = PROFILES[os.environ.get("PLUME_PROFILE", "log")]
 EXTRA = os.environ.get("PLUME_SET", "").split()

@@ -22,12 +22,12 @@ class FiguresTable(unittest.TestCase):
             self.rows = list(csv.DictReader(f))
 
     def test_committed_table_is_what_the_results_give(self):
-        self.assertEqual(open(os.path.join(ROOT, "docs", "validation", "figures.csv")).read(),
+        self.assertEqual(figures.read_text(os.path.join(ROOT, "docs", "validation", "figures.csv")),
                          figures.render(figures.table()),
                          "docs/validation/figures.csv is stale: run scripts/figures.py")
 
     def test_committed_reproduction_page_is_what_the_results_give(self):
-        self.assertEqual(open(os.path.join(ROOT, "docs", "reproduction.md")).read(),
+        self.assertEqual(figures.read_text(os.path.join(ROOT, "docs", "reproduction.md")),
                          figures.reproduction(figures.table()),
                          "docs/reproduction.md is stale: run scripts/figures.py")
 

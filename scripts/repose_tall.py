@@ -1,0 +1,294 @@
+#!/usr/bin/python3
+"""Angle of repose on tall poured heaps (docs/validation.md "Angle of repose").
+
+  scripts/repose_tall.py run [RUN...]   runs (default: all, in the order of RUNS), one at a time
+  scripts/repose_tall.py report         docs/validation/repose/report.md and heaps.png from the kept results
+  scripts/repose_tall.py list           the runs, and which are done
+
+Scenes: config/validation/pour_tall_moderate.yaml and pour_tall_gravel.yaml (a poured fixed-base
+cone at least 15 mean grain diameters tall). A run is one seed of one pour: "near" (the outlet 0.45 m
+above the base, about 0.1 m above the final apex, as in the files) or "high" (the outlet, plug and
+hopper's grains raised by 0.40 m). Each run is one regolith_sim process on one thread at the lowest
+priority (nice 15); the raw output goes to out/repose/RUN/. A finished run leaves
+docs/validation/repose/RUN/result.json (angle per quadrant, grains on the base, heap height in mean
+grain diameters, wall and CPU time, the command) and RUN/profile.png; a run whose result.json exists is
+skipped (REPOSE_RERUN=1 runs it again), so the study resumes on any machine once those files are
+committed. The angle is measured exactly as for the short heaps (scripts/lib/repose_angle.py, cone
+geometry: four quadrants, flank fits over 0.15 R <= r <= 0.85 R).
+
+Environment: REGOLITH_BIN (the folder of regolith_sim; default build/devel/lib/regolith_twin),
+REPOSE_NICE (default 15).
+"""
+import json
+import math
+import os
+import resource
+import shlex
+import subprocess
+import sys
+import time
+from argparse import Namespace
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.normpath(os.path.join(HERE, ".."))
+sys.path.insert(0, os.path.join(HERE, "lib"))
+import repose_angle  # noqa: E402
+
+DOCS = os.path.join(ROOT, "docs", "validation", "repose")
+OUT = os.path.join(ROOT, "out", "repose")
+BASE_TOP = 0.01  # top of the glued base grains (centres at z = 0, radius 0.01 m)
+MEAN_DIAMETER = 0.02
+PUBLISHED = {"gravel": 38.5, "moderate": 28.0}
+# Per material: the scene, the base radius R (m) and the fill's z range in the file (outlet 0.45 m).
+SCENES = {
+    "moderate": ("config/validation/pour_tall_moderate.yaml", 0.65, (1.125, 1.795)),
+    "gravel": ("config/validation/pour_tall_gravel.yaml", 0.45, (1.125, 1.475)),
+}
+OUTLET_IN_FILE = 0.45  # outlet above the base's top in the files (z = 0.46 m)
+OUTLET = {"near": 0.45, "high": 0.85}
+CONE_LENGTH = 0.6582  # the hopper cone, outlet radius 0.12 m to 0.5 m at 30 deg from the axis
+
+
+def overrides(material, pour, seed):
+    """--set overrides of one run: the seed, and for a raised pour the hopper (walls 2 and 3), the plug
+    (wall 4) and the hopper's grains (grains.1) moved up together."""
+    out = ["seed=%d" % seed]
+    shift = OUTLET[pour] - OUTLET_IN_FILE
+    if abs(shift) > 1e-12:
+        z_out = BASE_TOP + OUTLET[pour]
+        lo, hi = SCENES[material][2]
+        out += ["walls.2.base=[0, 0, %.4f]" % z_out,
+                "walls.3.base=[0, 0, %.4f]" % (z_out + CONE_LENGTH),
+                "walls.4.center=[0, 0, %.4f]" % z_out,
+                "grains.1.fill.z=[%.4f, %.4f]" % (lo + shift, hi + shift)]
+    return out
+
+
+def run_name(material, pour, seed):
+    return "tall_%s_%s_s%d" % (material, pour, seed)
+
+
+# The study, in the order it runs: the main moderate configuration (outlet near the apex) on three
+# seeds first, then gravel and the raised pour.
+PLAN = [("moderate", "near", 11), ("gravel", "near", 11), ("moderate", "high", 11), ("moderate", "near", 12),
+        ("moderate", "near", 13), ("gravel", "high", 11)]
+RUNS = {run_name(*p): p for p in PLAN}
+
+
+def read_snapshot(path):
+    """(x, y, z, r) of the free grains of a float32 bed snapshot (docs/model.md §14)."""
+    data = open(path, "rb").read()
+    if data[:8] != b"RGTWBED1":
+        raise SystemExit("%s: not a float32 bed snapshot" % path)
+    n = int(np.frombuffer(data[8:16], dtype=np.uint64)[0])
+    rec = np.frombuffer(data[16:16 + 16 * n], dtype=np.float32).reshape(n, 4).astype(float)
+    return rec[:, 0], rec[:, 1], rec[:, 2], rec[:, 3]
+
+
+def measure(final, R):
+    """The heap on the base (repose_angle.cone_profile) and the figures kept for a run."""
+    a = Namespace(half_length=R, base_top=BASE_TOP, bin=0.02)
+    p = repose_angle.cone_profile(final, a)
+    d = np.loadtxt(final)
+    z = d[:, 3]
+    edges = np.arange(0, R + 1e-12, a.bin)
+    rc = 0.5 * (edges[:-1] + edges[1:])
+    height = p["apex"] - BASE_TOP
+    # The heap covers the disk when the surface stands above the base in the outermost bin and grains
+    # ran off the rim to the catch floor (0.5 m below).
+    rim_h = p["h"][-1] - BASE_TOP if np.isfinite(p["h"][-1]) else 0.0
+    return p, dict(
+        angle_deg=float(np.mean(p["flanks"])),
+        quadrants_deg=[float(v) for v in p["flanks"]],
+        grains_on_base=p["n"],
+        apex_m=p["apex"],
+        heap_height_m=height,
+        heap_height_diameters=height / MEAN_DIAMETER,
+        ran_off=int(np.sum(z < -0.2)),
+        rim_surface_height_m=float(rim_h),
+        covers_disk=bool(rim_h > 0 and np.sum(z < -0.2) > 0),
+        base_radius_m=R,
+        mean_profile={"r_m": [round(float(v), 4) for v in rc],
+                      "h_m": [None if not np.isfinite(v) else round(float(v), 5) for v in p["h"]]},
+        mean_profile_fit_deg=math.degrees(math.atan(abs(p["fits"][0][0]))),
+    )
+
+
+def plot(path, res, p, title, published):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    R = res["base_radius_m"]
+    fig, ax = plt.subplots(figsize=(7.5, 3.4))
+    side = p["pile"] & (np.abs(p["y"]) < 0.02)
+    ax.scatter(np.abs(p["x"][side]), p["z"][side], s=2, c="0.6", label="grains within 2 cm of the plane y = 0")
+    ax.plot(p["xc"], p["h"], "-", color="tab:blue", lw=1.3, label="surface, mean of the four quadrants")
+    slope, icpt = p["fits"][0]
+    xx = np.array([0.15 * R, 0.85 * R])
+    ax.plot(xx, slope * xx + icpt, "--", color="tab:red", lw=1.6,
+            label="run: %.1f° (quadrants %s°)" % (res["angle_deg"], ", ".join("%.1f" % v for v in res["quadrants_deg"])))
+    ok = np.isfinite(p["h"])
+    z_mid = float(np.interp(0.5 * R, p["xc"][ok], p["h"][ok]))
+    t = math.tan(math.radians(published))
+    ax.plot([0, R], [z_mid + t * 0.5 * R, z_mid - t * 0.5 * R], "k:", lw=1.3,
+            label="published %g° (through the surface at r = R/2)" % published)
+    ax.axvspan(0.15 * R, 0.85 * R, color="0.93", zorder=0)
+    ax.set_xlim(0, R * 1.03)
+    ax.set_ylim(0, None)
+    ax.set_aspect("equal")
+    ax.set_xlabel("r (m)")
+    ax.set_ylabel("z (m)")
+    ax.set_title("%s: heap %.1f mean diameters tall, %d grains on the base" %
+                 (title, res["heap_height_diameters"], res["grains_on_base"]), fontsize=9)
+    ax.legend(fontsize=6.5, loc="upper right", framealpha=0.85)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def run_one(name, bin_dir):
+    material, pour, seed = RUNS[name]
+    keep = os.path.join(DOCS, name)
+    result = os.path.join(keep, "result.json")
+    if os.path.exists(result) and os.environ.get("REPOSE_RERUN") != "1":
+        print("%s: kept (%s)" % (name, os.path.relpath(result, ROOT)), flush=True)
+        return
+    config, R, _ = SCENES[material]
+    out = os.path.join(OUT, name)
+    os.makedirs(out, exist_ok=True)
+    sets = overrides(material, pour, seed)
+    nice = os.environ.get("REPOSE_NICE", "15")
+    cmd = ["nice", "-n", nice, os.path.join(bin_dir, "regolith_sim"), config, "--threads", "1", "--stage-snapshots",
+           "--out", os.path.relpath(out, ROOT), "--quiet"]
+    for s in sets:
+        cmd += ["--set", s]
+    shown = " ".join(shlex.quote(c) for c in ["regolith_sim"] + cmd[4:])
+    print("%s: %s" % (name, shown), flush=True)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.time()
+    r = subprocess.run(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    wall = time.time() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    if r.returncode != 0:
+        sys.stderr.write(r.stdout[-3000:])
+        raise SystemExit("%s: regolith_sim exit %d after %.0f s (nothing kept)" % (name, r.returncode, wall))
+    s = json.load(open(os.path.join(out, "summary.json")))
+    p, res = measure(os.path.join(out, "final_grains.txt"), R)
+    # Grains still above the outlet when the drain stage ended (0: the hopper had emptied).
+    x, y, z, _ = read_snapshot(os.path.join(out, "drain.bed"))
+    left = int(np.sum(z > BASE_TOP + OUTLET[pour]))
+    res = dict(
+        run=name, material=material, pour=pour, seed=seed,
+        outlet_above_base_m=OUTLET[pour], published_deg=PUBLISHED[material],
+        **res,
+        grains_left_in_hopper_after_drain=left,
+        stages={k: dict(t_end=v["t_end"], ended_by=v["ended_by"]) for k, v in s["stages"].items()},
+        sim_time_s=s["sim_time"], steps=s["steps"], kn=s["kn"], dt=s["dt"], grains=s["grains"],
+        max_overlap_ratio=s["max_overlap_ratio"],
+        wall_seconds=round(wall, 1), cpu_seconds=round(cpu, 1), threads=1,
+        command=shown, method="poured fixed-base cone, scripts/lib/repose_angle.py (cone: four quadrants, "
+                              "flank fits over 0.15 R <= r <= 0.85 R)")
+    os.makedirs(keep, exist_ok=True)
+    plot(os.path.join(keep, "profile.png"), res, p, "%s, outlet %s (%.2f m), seed %d" %
+         (material, pour, OUTLET[pour], seed), PUBLISHED[material])
+    with open(result, "w") as f:
+        json.dump(res, f, indent=1)
+    print("%s: %.2f deg (quadrants %s), %d grains on the base, heap %.1f d, %s; %.0f s wall, %.0f s CPU" %
+          (name, res["angle_deg"], " ".join("%.2f" % v for v in res["quadrants_deg"]), res["grains_on_base"],
+           res["heap_height_diameters"], "covers the disk" if res["covers_disk"] else "DOES NOT COVER THE DISK",
+           wall, cpu), flush=True)
+
+
+def load_done():
+    done = {}
+    for n in RUNS:
+        f = os.path.join(DOCS, n, "result.json")
+        if os.path.exists(f):
+            done[n] = json.load(open(f))
+    return done
+
+
+def report():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    done = load_done()
+    lines = ["# Angle of repose on tall poured heaps", "",
+             "Generated by `scripts/repose_tall.py report` from the runs kept under this folder "
+             "(`RUN/result.json`, `RUN/profile.png`). A run's angle is the mean of its four quadrants' flank fits "
+             "(scripts/lib/repose_angle.py, 0.15 R ≤ r ≤ 0.85 R); height is the apex of the mean surface above "
+             "the base's top, in mean grain diameters (2 cm).", "",
+             "| run | material | outlet above the base | R | angle | quadrants | heap height | grains on the base "
+             "| ran off | hopper empty | simulated | wall / CPU time (1 thread) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for n, r in done.items():
+        lines.append("| `%s` | %s | %.2f m | %.2f m | %.2f° | %s° | %.1f d | %d | %d | %s | %.1f s | %.0f / %.0f s |" % (
+            n, r["material"], r["outlet_above_base_m"], r["base_radius_m"], r["angle_deg"],
+            ", ".join("%.1f" % v for v in r["quadrants_deg"]), r["heap_height_diameters"], r["grains_on_base"],
+            r["ran_off"], "yes" if r["grains_left_in_hopper_after_drain"] == 0 else
+            "no (%d left)" % r["grains_left_in_hopper_after_drain"], r["sim_time_s"], r["wall_seconds"],
+            r["cpu_seconds"]))
+    lines += ["", "Per material and pour (mean ± sample standard deviation over the seeds; single quadrants' range):", "",
+              "| material | pour | seeds | heap height | angle | single quadrants | published |", "|---|---|---|---|---|---|---|"]
+    groups = {}
+    for r in done.values():
+        groups.setdefault((r["material"], r["pour"]), []).append(r)
+    for (m, pour), rs in sorted(groups.items()):
+        ang = np.array([r["angle_deg"] for r in rs])
+        q = [v for r in rs for v in r["quadrants_deg"]]
+        sd = " ± %.2f°" % np.std(ang, ddof=1) if len(rs) > 1 else ""
+        lines.append("| %s | %s (%.2f m) | %s | %.1f–%.1f d | %.2f°%s | %.1f–%.1f° | %g° |" % (
+            m, pour, rs[0]["outlet_above_base_m"], " ".join(str(r["seed"]) for r in rs),
+            min(r["heap_height_diameters"] for r in rs), max(r["heap_height_diameters"] for r in rs),
+            ang.mean(), sd, min(q), max(q), PUBLISHED[m]))
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.6))
+    for ax, m in zip(axes, ("moderate", "gravel")):
+        for n, r in done.items():
+            if r["material"] != m:
+                continue
+            rc = np.array(r["mean_profile"]["r_m"])
+            h = np.array([np.nan if v is None else v for v in r["mean_profile"]["h_m"]])
+            ax.plot(rc, h, "-" if r["pour"] == "near" else "--",
+                    label="%s s%d: %.1f°" % (r["pour"], r["seed"], r["angle_deg"]))
+        ax.set_title("%s (published %g°)" % (m, PUBLISHED[m]), fontsize=9)
+        ax.set_xlabel("r (m)")
+        ax.set_ylabel("mean surface height (m)")
+        ax.set_aspect("equal")
+        ax.set_ylim(0, None)
+        ax.grid(alpha=0.3)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(DOCS, "heaps.png"), dpi=110)
+    plt.close(fig)
+    lines += ["", "![mean surfaces of the tall heaps](heaps.png)"]
+    with open(os.path.join(DOCS, "report.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+def main():
+    if len(sys.argv) < 2 or sys.argv[1] not in ("run", "report", "list"):
+        raise SystemExit(__doc__)
+    bin_dir = os.environ.get("REGOLITH_BIN", os.path.join(ROOT, "build", "devel", "lib", "regolith_twin"))
+    os.makedirs(DOCS, exist_ok=True)
+    if sys.argv[1] == "list":
+        done = load_done()
+        for n in RUNS:
+            print("%-28s %s" % (n, "done" if n in done else "-"))
+        return
+    if sys.argv[1] == "run":
+        names = sys.argv[2:] or list(RUNS)
+        for n in names:
+            if n not in RUNS:
+                raise SystemExit("unknown run '%s' (%s)" % (n, " ".join(RUNS)))
+        for n in names:
+            run_one(n, bin_dir)
+    report()
+
+
+if __name__ == "__main__":
+    main()

@@ -369,6 +369,8 @@ def _num(x, digits):
         return "0"
     p = digits - 1 - int(math.floor(math.log10(abs(x))))
     x = round(x, p)
+    if float(x).is_integer():
+        p = 0  # a count (or a round figure) without a trailing ".0"
     return "{:,.{}f}".format(x, max(p, 0))
 
 

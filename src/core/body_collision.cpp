@@ -1,5 +1,6 @@
 // Body–body contacts through Bullet's narrow phase (see body_collision.hpp).
 #include "regolith_twin/core/body_collision.hpp"
+#include "regolith_twin/core/hash.hpp"
 
 #include <BulletCollision/CollisionDispatch/btCollisionObjectWrapper.h>
 #include <BulletCollision/CollisionDispatch/btManifoldResult.h>
@@ -101,31 +102,22 @@ struct Candidate {
   int i, j;  // new point, old point
 };
 
-uint64_t fnv(uint64_t h, const void* data, size_t n) {
-  const unsigned char* p = static_cast<const unsigned char*>(data);
-  for (size_t i = 0; i < n; ++i) {
-    h ^= p[i];
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
 // Fingerprint of everything the geometry is built from (mesh contents by size only).
 uint64_t geometry_key(const Model& m) {
-  uint64_t h = 1469598103934665603ull;
+  uint64_t h = kFnvOffset;
   for (const BodyModel& b : m.bodies) {
     const int fixed = b.fixed ? 1 : 0;
-    h = fnv(h, &fixed, sizeof fixed);
+    h = fnv1a(&fixed, sizeof fixed, h);
     const size_t ns = b.shapes.size();
-    h = fnv(h, &ns, sizeof ns);
+    h = fnv1a(&ns, sizeof ns, h);
     for (const Shape& sh : b.shapes) {
       const double v[11] = {sh.pos.x(), sh.pos.y(), sh.pos.z(), sh.rot.w(), sh.rot.x(), sh.rot.y(),
                             sh.rot.z(), sh.size.x(), sh.size.y(), sh.size.z(), static_cast<double>(sh.type)};
-      h = fnv(h, v, sizeof v);
+      h = fnv1a(v, sizeof v, h);
       if (sh.type == ShapeType::Mesh && sh.mesh >= 0 && sh.mesh < static_cast<int>(b.meshes.size())) {
         const size_t nv = b.meshes[sh.mesh].vertices.size(), nt = b.meshes[sh.mesh].triangles.size();
-        h = fnv(h, &nv, sizeof nv);
-        h = fnv(h, &nt, sizeof nt);
+        h = fnv1a(&nv, sizeof nv, h);
+        h = fnv1a(&nt, sizeof nt, h);
       }
     }
   }

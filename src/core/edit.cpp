@@ -1,6 +1,7 @@
 // Editing the grains of a scene between steps (see edit.hpp): per-grain
 // arrays compacted or extended, contact lists renumbered with their springs.
 #include "regolith_twin/core/edit.hpp"
+#include "regolith_twin/core/types.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -12,7 +13,6 @@
 namespace rt {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // v[map[i]] = v[i] for every kept i (map[i] <= i, so in place), then shrink.
 template <class T>

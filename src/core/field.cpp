@@ -1,5 +1,6 @@
 // Field stage: per-grain forces added after the contact pass (see field.hpp).
 #include "regolith_twin/core/field.hpp"
+#include "regolith_twin/core/types.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -104,7 +105,6 @@ Vec3 GasField::force_at(double r, double h, const Vec3& x, const Vec3& v) const 
 }
 
 Vec3 GasField::force(double r, double h, const Vec3& v, const Vec3& e, double rho) const {
-  constexpr double kPi = 3.14159265358979323846;
   const double d = 2 * r;
   const double u = p_.velocity(h);
   const Vec3 v0 = u * e - v;

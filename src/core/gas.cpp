@@ -1,12 +1,12 @@
 // Loth (2008) drag and lift coefficients (see gas.hpp; docs/model.md §10).
 #include "regolith_twin/core/gas.hpp"
+#include "regolith_twin/core/types.hpp"
 
 #include <cmath>
 
 namespace rt {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 // Below this Mach number the Ma^4 free-molecular term of the rarefaction
 // branch is dropped: it is below 1e-24 of C_D there, and C_D,fm's two
 // 1/s^3 terms cancel to rounding.

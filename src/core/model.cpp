@@ -4,13 +4,13 @@
 #include <sstream>
 
 #include "regolith_twin/core/model.hpp"
+#include "regolith_twin/core/types.hpp"
 
 #include "regolith_twin/core/body_collision.hpp"
 
 namespace rt {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 double ln2_pi2(double eps) {
   const double l = std::log(eps);

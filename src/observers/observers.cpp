@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "regolith_twin/core/edit.hpp"
+#include "regolith_twin/core/types.hpp"
 #include "regolith_twin/core/step.hpp"
 #include "regolith_twin/observers/active_zone.hpp"
 #include "regolith_twin/observers/body_contacts.hpp"
@@ -46,7 +47,7 @@ bool Ejecta::after_step(Model& m, State& s) {
     if (!flag_[i] && !above0_[i] && s.pos[i].z() > height_) {
       flag_[i] = 1;
       ++count_;
-      volume_ += 4.0 / 3.0 * M_PI * std::pow(m.grain_radius[i], 3);
+      volume_ += 4.0 / 3.0 * kPi * std::pow(m.grain_radius[i], 3);
     }
   return false;
 }

@@ -1,5 +1,6 @@
 // Seeded grain generation.
 #include "regolith_twin/scene/generate.hpp"
+#include "regolith_twin/core/types.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -76,7 +77,7 @@ RandomFill random_sites(const Region& r, const std::vector<double>& radii, doubl
       if (r.shape == RegionShape::Cylinder) {
         const double rad = r.radius - keep;
         // Uniform over the disk: radius from the square root.
-        const double s = rad * std::sqrt(u01(rng)), phi = 2 * M_PI * u01(rng);
+        const double s = rad * std::sqrt(u01(rng)), phi = 2 * kPi * u01(rng);
         p = Vec3(r.center.x() + s * std::cos(phi), r.center.y() + s * std::sin(phi), 0);
       } else {
         p.x() = lo.x() + keep + (hi.x() - lo.x() - 2 * keep) * u01(rng);

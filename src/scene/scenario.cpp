@@ -280,7 +280,7 @@ Quat parse_orientation(const Reader& rd, const YAML::Node& parent, const std::st
     return q.normalized();
   }
   const bool deg = bool(o["rpy_deg"]);
-  const Vec3 a = rd.vec3(o, p, deg ? "rpy_deg" : "rpy", Vec3::Zero(), true) * (deg ? M_PI / 180 : 1.0);
+  const Vec3 a = rd.vec3(o, p, deg ? "rpy_deg" : "rpy", Vec3::Zero(), true) * (deg ? kPi / 180 : 1.0);
   return Quat(Eigen::AngleAxisd(a.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(a.y(), Vec3::UnitY()) *
               Eigen::AngleAxisd(a.x(), Vec3::UnitX()));
 }
@@ -526,7 +526,7 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source) {
   double mean_mass = 0, min_r = 1e300;
   for (int i = 0; i < m.n_grains; ++i) {
     const double r = m.grain_radius[i];
-    mean_mass += 4.0 / 3.0 * M_PI * r * r * r * m.materials[m.grain_material[i]].density;
+    mean_mass += 4.0 / 3.0 * kPi * r * r * r * m.materials[m.grain_material[i]].density;
     min_r = std::min(min_r, r);
   }
   if (m.n_grains == 0) {

@@ -1,5 +1,6 @@
 // Analytic verification of binary collisions (see collisions.hpp).
 #include "regolith_twin/validate/collisions.hpp"
+#include "regolith_twin/core/types.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +13,6 @@
 namespace rt::validate {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 double sphere_mass(double r, double density) { return 4.0 / 3.0 * kPi * r * r * r * density; }
 

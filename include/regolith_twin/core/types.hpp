@@ -10,6 +10,8 @@ namespace rt {
 
 using Vec3 = Eigen::Vector3d;
 
+constexpr double kPi = 3.14159265358979323846;
+
 // An error in user input (scenario file, parameter, data file). The message
 // names the file, the key and the allowed range.
 struct InputError : std::runtime_error {

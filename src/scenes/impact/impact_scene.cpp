@@ -1,5 +1,6 @@
 // The bucket-impact scene kind (see impact_scene.hpp; docs/scenes.md C.1).
 #include "regolith_twin/scenes/impact/impact_scene.hpp"
+#include "regolith_twin/core/types.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -17,7 +18,6 @@
 namespace rt {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 class ImpactKind : public SceneKind {

@@ -1,5 +1,6 @@
 // The inclined-plane scene kind (see incline_scene.hpp; docs/scenes.md C.2).
 #include "regolith_twin/scenes/incline/incline_scene.hpp"
+#include "regolith_twin/core/types.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -16,7 +17,6 @@
 namespace rt {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 class InclineKind : public SceneKind {
  public:

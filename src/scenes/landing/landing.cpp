@@ -1,6 +1,7 @@
 // Lander scenes: placement, perturbed beds and the landing outcome
 // (docs/scenes.md A). See landing.hpp.
 #include "regolith_twin/scenes/landing/landing.hpp"
+#include "regolith_twin/core/types.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -22,7 +23,7 @@
 namespace rt {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
+constexpr double kDeg = kPi / 180.0;
 
 // Horizontal direction of motion.
 Vec3 heading_dir(const LandingSpec& sp) { return Vec3(std::cos(sp.heading_deg * kDeg), std::sin(sp.heading_deg * kDeg), 0); }
@@ -37,7 +38,7 @@ void extreme_points(const BodyModel& b, const Shape& sh, const Quat& q_world, st
       break;
     case ShapeType::Cylinder:
       for (int k = 0; k < 72; ++k) {
-        const double a = 2 * M_PI * k / 72;
+        const double a = 2 * kPi * k / 72;
         add(Vec3(sh.size.x() * std::cos(a), sh.size.x() * std::sin(a), sh.size.z()));
         add(Vec3(sh.size.x() * std::cos(a), sh.size.x() * std::sin(a), -sh.size.z()));
       }
@@ -129,8 +130,8 @@ Perturbation perturbation(const LandingSpec& sp, double mean_radius) {
   if (sp.repeat <= 0) return p;
   std::mt19937_64 rng(sp.perturb_seed * 1000003ULL + static_cast<unsigned long>(sp.repeat));
   std::uniform_real_distribution<double> u(0, 1);
-  p.angle = 2 * M_PI * u(rng);
-  const double rad = 2 * mean_radius * std::sqrt(u(rng)), phi = 2 * M_PI * u(rng);  // uniform in a disk of one diameter
+  p.angle = 2 * kPi * u(rng);
+  const double rad = 2 * mean_radius * std::sqrt(u(rng)), phi = 2 * kPi * u(rng);  // uniform in a disk of one diameter
   p.aim_offset = Vec3(rad * std::cos(phi), rad * std::sin(phi), 0);
   return p;
 }

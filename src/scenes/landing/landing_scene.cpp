@@ -124,10 +124,10 @@ std::unique_ptr<Scene> LandingKind::prepare(const YAML::Node& doc, const std::st
   double vol = 0;
   for (int i = 0; i < m.n_grains; ++i) {
     const double r = m.grain_radius[i];
-    if (s.pos[i].z() <= ls->spec.rim) vol += 4.0 / 3.0 * M_PI * r * r * r;
+    if (s.pos[i].z() <= ls->spec.rim) vol += 4.0 / 3.0 * kPi * r * r * r;
   }
   const double mean_r = mean_radius(m);
-  const double box = M_PI * ls->spec.container_radius * ls->spec.container_radius * ls->spec.rim;
+  const double box = kPi * ls->spec.container_radius * ls->spec.container_radius * ls->spec.rim;
   ls->packing = vol / box;
   ls->bulk_density = m.n_grains ? ls->packing * m.materials[m.grain_material[0]].density : 0;
 
@@ -150,12 +150,6 @@ std::unique_ptr<Scene> LandingKind::prepare(const YAML::Node& doc, const std::st
 
 std::shared_ptr<const SceneKind> landing_kind() { return std::make_shared<LandingKind>(); }
 
-std::unique_ptr<LandingScene> prepare_landing(const std::string& file, const std::vector<std::string>& overrides,
-                                              const SceneOptions& opt) {
-  std::unique_ptr<Scene> sc = LandingKind().prepare(load_document(file, overrides), file, opt);
-  return std::unique_ptr<LandingScene>(static_cast<LandingScene*>(sc.release()));
-}
-
 void write_landing_summary(const std::string& path, const LandingScene& ls, const LandingOutcome& o, int threads,
                            const RunReport* rep) {
   const LandingSpec& spec = ls.spec;
@@ -167,7 +161,7 @@ void write_landing_summary(const std::string& path, const LandingScene& ls, cons
   in.str("attitude", attitude_name(spec.attitude));
   in.num("angle_deg", spec.angle_deg).num("speed", spec.speed).num("gravity", spec.g).num("slope_deg", spec.slope_deg);
   in.num("pitch_deg", spec.pitch_deg).num("roll_deg", spec.roll_deg).num("heading_deg", spec.heading_deg);
-  in.num("repeat", double(spec.repeat)).num("bed_rotation_deg", ls.pert.angle * 180 / M_PI);
+  in.num("repeat", double(spec.repeat)).num("bed_rotation_deg", ls.pert.angle * 180 / kPi);
   in.nums("aim", {ls.run_spec.aim.x(), ls.run_spec.aim.y()});
   j.obj("input", in);
   JsonObject bed;

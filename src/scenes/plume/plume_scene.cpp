@@ -1,5 +1,6 @@
 // The plume-erosion scene kind (see plume_scene.hpp; docs/scenes.md D).
 #include "regolith_twin/scenes/plume/plume_scene.hpp"
+#include "regolith_twin/core/types.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -17,7 +18,6 @@
 namespace rt {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 class PlumeKind : public SceneKind {
  public:

@@ -1,6 +1,7 @@
 // Crater depth and radius, and the packing below the filter (see crater.hpp,
 // packing_below_filter.hpp; docs/scenes.md B.3).
 #include "regolith_twin/scenes/sampler/crater.hpp"
+#include "regolith_twin/core/types.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +11,6 @@
 namespace rt {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Area of the intersection of a disk of radius a whose centre is at distance
 // d from the origin with the disk of radius R about the origin.

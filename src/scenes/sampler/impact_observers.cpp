@@ -1,5 +1,6 @@
 // Measurements around the sampler projectile's impact (docs/scenes.md B.4).
 #include "regolith_twin/scenes/sampler/impact_observers.hpp"
+#include "regolith_twin/core/types.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,7 +14,6 @@
 namespace rt {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 const ImpactClock* need_clock(const ImpactClock* c, const char* who) {

@@ -1,5 +1,6 @@
 // The sampler scene kind (see sampler_scene.hpp; docs/scenes.md B).
 #include "regolith_twin/scenes/sampler/sampler_scene.hpp"
+#include "regolith_twin/core/types.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -19,7 +20,6 @@
 namespace rt {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 int every_steps(double seconds, double dt) { return std::max(1, int(std::lround(seconds / dt))); }
 

@@ -1,6 +1,7 @@
 // Maxwell's Z-model and its fit to a measured velocity field
 // (definitions in include/regolith_twin/scenes/sampler/zmodel.hpp).
 #include "regolith_twin/scenes/sampler/zmodel.hpp"
+#include "regolith_twin/core/types.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +13,6 @@ namespace rt {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = 180.0 / kPi;
 
 double wrap_angle(double a) {

@@ -59,10 +59,6 @@ class LandingRun : public SceneRun {
 // The landing kind for the registry.
 std::shared_ptr<const SceneKind> landing_kind();
 
-// A landing file prepared (as load_scene does for a file with a `landing:` block).
-std::unique_ptr<LandingScene> prepare_landing(const std::string& file, const std::vector<std::string>& overrides,
-                                              const SceneOptions& opt);
-
 // summary.json of a landing: input, bed, outcome, run figures.
 void write_landing_summary(const std::string& path, const LandingScene& ls, const LandingOutcome& o, int threads,
                            const RunReport* rep = nullptr);

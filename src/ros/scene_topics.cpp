@@ -8,7 +8,7 @@
 
 namespace rt_ros {
 
-// The built-in kinds' topics, one line each (src/scenes/ros_registry.cpp).
+// The built-in kinds' topics, one line each (src/ros/scenes/registry.cpp).
 std::vector<std::pair<std::string, SceneTopicsFactory>> builtin_scene_topics();
 
 namespace {

@@ -1,7 +1,7 @@
 // What a scene kind adds to the ROS node: its own topics, published after a
 // step and at the run end, and its markers. The node knows no scene kind: it
 // asks this registry for the topics of the twin's kind (built-in kinds:
-// src/scenes/ros_registry.cpp; tests register their own).
+// src/ros/scenes/registry.cpp; tests register their own).
 #pragma once
 
 #include <ros/ros.h>

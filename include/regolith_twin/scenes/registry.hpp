@@ -1,5 +1,5 @@
 // The scene kinds built into the package: one line each in
-// src/scenes/registry.cpp (their ROS topics: src/scenes/ros_registry.cpp).
+// src/scenes/registry.cpp (their ROS topics: src/ros/scenes/registry.cpp).
 #pragma once
 
 #include <memory>

@@ -1,5 +1,5 @@
-// The landing's ROS topics (see ros_topics.hpp).
-#include "regolith_twin/scenes/landing/ros_topics.hpp"
+// The landing's ROS topics (see include/regolith_twin/ros/scenes/).
+#include "regolith_twin/ros/scenes/landing.hpp"
 
 #include <cstdio>
 

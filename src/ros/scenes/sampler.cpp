@@ -1,5 +1,5 @@
-// The sampler's ROS topics (see ros_topics.hpp).
-#include "regolith_twin/scenes/sampler/ros_topics.hpp"
+// The sampler's ROS topics (see include/regolith_twin/ros/scenes/).
+#include "regolith_twin/ros/scenes/sampler.hpp"
 
 #include <cstdio>
 

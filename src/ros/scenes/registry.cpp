@@ -1,7 +1,7 @@
 // The built-in scene kinds' ROS topics: one line per kind that has its own.
 #include "regolith_twin/ros/scene_topics.hpp"
-#include "regolith_twin/scenes/landing/ros_topics.hpp"
-#include "regolith_twin/scenes/sampler/ros_topics.hpp"
+#include "regolith_twin/ros/scenes/landing.hpp"
+#include "regolith_twin/ros/scenes/sampler.hpp"
 
 namespace rt_ros {
 

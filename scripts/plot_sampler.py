@@ -32,6 +32,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
 from csv_columns import read_csv  # noqa: E402
+from plots import save_figure  # noqa: E402
 
 
 def plot_wave(d, caps):
@@ -68,9 +69,7 @@ def plot_wave(d, caps):
     ax.set_xlabel("distance from the impact point (mm)")
     ax.set_ylabel("largest grain speed in the bin (m/s)")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(os.path.join(d, "wave.png"), dpi=110)
-    plt.close(fig)
+    save_figure(fig, os.path.join(d, "wave.png"))
 
 
 def plot_front_track(d, caps, bin_width, floor=None):
@@ -98,9 +97,7 @@ def plot_front_track(d, caps, bin_width, floor=None):
     ax.set_xlabel("time after impact (µs)")
     ax.set_ylabel("distance from the impact point (mm)")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(d, "wave_front.png"), dpi=110)
-    plt.close(fig)
+    save_figure(fig, os.path.join(d, "wave_front.png"))
 
 
 def main():
@@ -125,9 +122,7 @@ def main():
         ax[1].set_xlabel("time after firing (ms)")
         ax[1].set_ylabel("collected mass (mg)")
         ax[1].legend()
-        fig.tight_layout()
-        fig.savefig(os.path.join(d, "horn.png"), dpi=110)
-        plt.close(fig)
+        save_figure(fig, os.path.join(d, "horn.png"))
         fig, ax = plt.subplots(1, 2, figsize=(11, 4))
         ta = (s["t"] - t_imp) * 1e3
         ax[0].plot(ta, s["crater_depth"] * 1e3, label="depth")
@@ -138,9 +133,7 @@ def main():
         ax[1].plot(ta, s["ejected_volume"] * 1e6)
         ax[1].set_xlabel("time after impact (ms)")
         ax[1].set_ylabel("ejected volume (cm$^3$)")
-        fig.tight_layout()
-        fig.savefig(os.path.join(d, "crater.png"), dpi=110)
-        plt.close(fig)
+        save_figure(fig, os.path.join(d, "crater.png"))
     e = read_csv(os.path.join(d, "ejecta.csv"))
     if e is not None:
         fig, ax = plt.subplots(1, 2, figsize=(11, 4))
@@ -150,9 +143,7 @@ def main():
         ax[1].loglog(e["r_launch_over_R"], e["speed_over_sqrt_gR"], ".", ms=3)
         ax[1].set_xlabel("launch position r / R")
         ax[1].set_ylabel("launch speed / sqrt(g R)")
-        fig.tight_layout()
-        fig.savefig(os.path.join(d, "ejecta.png"), dpi=110)
-        plt.close(fig)
+        save_figure(fig, os.path.join(d, "ejecta.png"))
     en = read_csv(os.path.join(d, "energy_partition.csv"))
     if en is not None:
         fig, ax = plt.subplots(figsize=(7, 4.5))
@@ -164,9 +155,7 @@ def main():
         ax.set_xlabel("time after impact (ms)")
         ax.set_ylabel("energy / projectile's initial kinetic energy")
         ax.legend(fontsize=7)
-        fig.tight_layout()
-        fig.savefig(os.path.join(d, "energy.png"), dpi=110)
-        plt.close(fig)
+        save_figure(fig, os.path.join(d, "energy.png"))
     wave = obs.get("wave", {})
     caps = sorted((v for v in wave.values() if isinstance(v, dict)), key=lambda c: c["t"])
     if caps and all("front_method" in c for c in caps):
@@ -185,9 +174,7 @@ def main():
             ax.set_xlabel("distance from the impact point (mm)")
             ax.set_ylabel("largest grain speed (m/s)")
             ax.legend()
-            fig.tight_layout()
-            fig.savefig(os.path.join(d, "wave.png"), dpi=110)
-            plt.close(fig)
+            save_figure(fig, os.path.join(d, "wave.png"))
     return 0
 
 

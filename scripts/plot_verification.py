@@ -18,6 +18,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
+from plots import save_figure  # noqa: E402
+
 
 def read_csv(path):
     with open(path, newline="") as f:
@@ -107,9 +110,7 @@ def plot_test3(rows, out):
     ax2.set_ylim(-lim, lim)
     ax2.grid(True, alpha=0.3)
     ax2.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
+    save_figure(fig, out)
 
 
 # Kharaz et al. (2001): 5 mm spheres (R = 2.5 mm) at 3.9 m/s, as test 4.

@@ -10,6 +10,7 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
 import campaign_cli  # noqa: E402
+from plots import save_figure  # noqa: E402
 
 import matplotlib
 
@@ -166,9 +167,7 @@ def plot_groups(runs, groups, path, title):
     ax.set_title(title)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def report(docs, RUNS):
@@ -234,7 +233,6 @@ def report(docs, RUNS):
     # Rate over the (eps, mu) grid.
     pts = []
     for name, rs in runs.items():
-        ov = RUNS.get(name, ([],))[0]
         if name == "base" or name.startswith("e0"):
             e_val = 0.8 if name == "base" else float(name[1:].split("_mu")[0])
             mu = 0.2 if name == "base" else float(name.split("_mu")[1])
@@ -250,9 +248,7 @@ def report(docs, RUNS):
         ax.set_ylabel("erosion rate (grains/s)")
         ax.grid(alpha=0.3)
         ax.legend()
-        fig.tight_layout()
-        fig.savefig(os.path.join(docs, "rate_eps_mu.png"), dpi=110)
-        plt.close(fig)
+        save_figure(fig, os.path.join(docs, "rate_eps_mu.png"))
         lines.append("![rate over ε and μ](rate_eps_mu.png)")
     cal = os.path.join(docs, "calibration.json")
     if os.path.exists(cal):

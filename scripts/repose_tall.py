@@ -35,6 +35,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, ".."))
 sys.path.insert(0, os.path.join(HERE, "lib"))
 import repose_angle  # noqa: E402
+from plots import save_figure  # noqa: E402
 
 DOCS = os.path.join(ROOT, "docs", "validation", "repose")
 OUT = os.path.join(ROOT, "out", "repose")
@@ -143,9 +144,7 @@ def plot(path, res, p, title, published):
     ax.set_title("%s: heap %.1f mean diameters tall, %d grains on the base" %
                  (title, res["heap_height_diameters"], res["grains_on_base"]), fontsize=9)
     ax.legend(fontsize=6.5, loc="upper right", framealpha=0.85)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def run_one(name, bin_dir):
@@ -261,9 +260,7 @@ def report():
         ax.grid(alpha=0.3)
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(os.path.join(DOCS, "heaps.png"), dpi=110)
-    plt.close(fig)
+    save_figure(fig, os.path.join(DOCS, "heaps.png"))
     lines += ["", "![mean surfaces of the tall heaps](heaps.png)"]
     with open(os.path.join(DOCS, "report.md"), "w") as f:
         f.write("\n".join(lines) + "\n")

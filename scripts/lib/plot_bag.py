@@ -22,6 +22,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import rosbag  # noqa: E402
+from plots import save_figure  # noqa: E402
 
 
 def two_panels(series, path, left, right, equal_right=False):
@@ -35,9 +36,7 @@ def two_panels(series, path, left, right, equal_right=False):
         axis.legend()
     if equal_right:
         ax[1].set_aspect("equal", adjustable="datalim")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def main():

@@ -28,6 +28,8 @@ import math
 
 import numpy as np
 
+from plots import save_figure
+
 
 def load(path):
     d = np.loadtxt(path)
@@ -171,9 +173,7 @@ def plot(a, runs, angles, spread):
     ax.set_ylabel("z (m)")
     ax.set_title(f"{a.title}: {angles.mean():.1f}° ± {spread:.1f}° over {len(angles)} seeds", fontsize=10)
     ax.legend(fontsize=6.5, loc="upper right", framealpha=0.8)
-    fig.tight_layout()
-    fig.savefig(a.png, dpi=110)
-    plt.close(fig)
+    save_figure(fig, a.png)
 
 
 if __name__ == "__main__":

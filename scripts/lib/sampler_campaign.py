@@ -18,6 +18,8 @@ import os
 import re
 import sys
 
+from plots import save_figure
+
 RUN = re.compile(r"^c(\d+)_r(\d+)$")
 
 
@@ -159,9 +161,7 @@ def main():
         a.set_xlabel("time after firing (s)")
         a.set_ylabel(lab)
     ax[0][0].legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(docs, "campaign_series.png"), dpi=110)
-    plt.close(fig)
+    save_figure(fig, os.path.join(docs, "campaign_series.png"))
     fig, ax = plt.subplots(figsize=(6.5, 4))
     for name, (v, rep, s, o) in runs.items():
         h, b = o["hist"], o["bin_deg"]
@@ -173,9 +173,7 @@ def main():
     ax.set_xlabel("ejection angle from the horizontal (deg)")
     ax.set_ylabel("fraction of ejected grains")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(docs, "campaign_ejection_angles.png"), dpi=110)
-    plt.close(fig)
+    save_figure(fig, os.path.join(docs, "campaign_ejection_angles.png"))
     return 0
 
 

@@ -116,4 +116,15 @@ BodyModel box_body(const std::string& name, const Vec3& half, double density, bo
   return b;
 }
 
+SceneRunOutcome run_scene(const Scene& sc, Model& m, State& s) {
+  RunOptions ro;
+  ro.progress_every = 0;
+  Run run(m, s, sc.plan, ro);
+  SceneRunOutcome out;
+  out.run = sc.begin(run);
+  for (Observer* o : out.run->observers()) run.add_observer(o);
+  out.report = run.run();
+  return out;
+}
+
 }  // namespace rt::test

@@ -1,6 +1,7 @@
 // Helpers shared by the engine tests: small models built in code.
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include "regolith_twin/core/body.hpp"
@@ -8,6 +9,8 @@
 #include "regolith_twin/core/model.hpp"
 #include "regolith_twin/core/state.hpp"
 #include "regolith_twin/core/step.hpp"
+#include "regolith_twin/run/run.hpp"
+#include "regolith_twin/run/scene.hpp"
 
 namespace rt::test {
 
@@ -33,5 +36,14 @@ BodyModel box_body(const std::string& name, const Vec3& half, double density, bo
 // The closed box [lo, hi] as a triangle mesh, each face cut into n x n
 // cells of two triangles, wound outwards (vertices shared within a face).
 TriangleMesh box_mesh(const Vec3& lo, const Vec3& hi, int n);
+
+// A prepared scene run to its end from (m, s), normally copies of sc.sc.model
+// and sc.start that the run advances, with the scene's observers and no
+// progress lines: the run's report and the scene's run (its results).
+struct SceneRunOutcome {
+  RunReport report;
+  std::unique_ptr<SceneRun> run;
+};
+SceneRunOutcome run_scene(const Scene& sc, Model& m, State& s);
 
 }  // namespace rt::test

@@ -10,6 +10,7 @@
 #include "regolith_twin/core/body.hpp"
 #include "regolith_twin/core/model.hpp"
 #include "regolith_twin/scenes/impact/impact_scene.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -163,12 +164,9 @@ TEST(ImpactScene, ASphereIntoASettledBed) {
   // The impact.
   rt::Model m = m0;
   rt::State s = sc.start;
-  rt::RunOptions ro;
-  ro.progress_every = 0;
-  rt::Run run(m, s, sc.plan, ro);
-  auto sr = sc.begin(run);
-  for (rt::Observer* o : sr->observers()) run.add_observer(o);
-  const rt::RunReport rep = run.run();
+  rt::test::SceneRunOutcome ran = rt::test::run_scene(sc, m, s);
+  const rt::RunReport& rep = ran.report;
+  auto& sr = ran.run;
   ASSERT_EQ(rep.status, "ok") << rep.message << " at t = " << rep.sim_time;
   const auto& t = static_cast<rt::ImpactRun&>(*sr).tracker();
   EXPECT_GT(t.contact_time(), 0);

@@ -172,12 +172,9 @@ TEST(ImpulseObserver, EveryGrainsMomentumBalanceClosesOnAnErodingBed) {
   rt::Model m = sc.sc.model;
   rt::State s = sc.start;
   omp_set_num_threads(1);
-  rt::RunOptions ro;
-  ro.progress_every = 0;
-  rt::Run run(m, s, sc.plan, ro);
-  auto sr = sc.begin(run);
-  for (rt::Observer* o : sr->observers()) run.add_observer(o);
-  const rt::RunReport rep = run.run();
+  rt::test::SceneRunOutcome ran = rt::test::run_scene(sc, m, s);
+  const rt::RunReport& rep = ran.report;
+  auto& sr = ran.run;
   ASSERT_EQ(rep.status, "ok") << rep.message;
   const auto& pr = static_cast<rt::PlumeRun&>(*sr);
   const rt::ImpulseObserver& o = pr.impulse();

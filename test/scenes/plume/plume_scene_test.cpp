@@ -168,12 +168,9 @@ struct PlumeResult {
 PlumeResult run_plume(const rt::PlumeScene& sc, bool parallel = false) {
   PlumeResult out{sc.sc.model, sc.start};
   if (parallel) out.m.parallel_min_grains = 0;  // the threaded passes even for 400 grains
-  rt::RunOptions ro;
-  ro.progress_every = 0;
-  rt::Run run(out.m, out.s, sc.plan, ro);
-  auto sr = sc.begin(run);
-  for (rt::Observer* o : sr->observers()) run.add_observer(o);
-  const rt::RunReport rep = run.run();
+  rt::test::SceneRunOutcome ran = rt::test::run_scene(sc, out.m, out.s);
+  const rt::RunReport& rep = ran.report;
+  auto& sr = ran.run;
   EXPECT_EQ(rep.status, "ok") << rep.message;
   const auto& e = static_cast<rt::PlumeRun&>(*sr).erosion();
   out.above = e.above();

@@ -14,6 +14,7 @@
 
 #include "regolith_twin/scene/checkpoint.hpp"
 #include "regolith_twin/scenes/sampler/sampler_scene.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -70,12 +71,9 @@ struct ShotResult {
 // One shot of a loaded scene to its end, with the scene's observers.
 ShotResult run_shot(std::unique_ptr<rt::SamplerScene> sc) {
   ShotResult out{sc->sc.model, sc->start};
-  rt::RunOptions ro;
-  ro.progress_every = 0;
-  rt::Run run(out.m, out.s, sc->plan, ro);
-  auto sr = sc->begin(run);
-  for (rt::Observer* o : sr->observers()) run.add_observer(o);
-  const rt::RunReport rep = run.run();
+  rt::test::SceneRunOutcome ran = rt::test::run_scene(*sc, out.m, out.s);
+  const rt::RunReport& rep = ran.report;
+  auto& sr = ran.run;
   EXPECT_EQ(rep.status, "ok") << rep.message;
   auto& r = static_cast<rt::SamplerRun&>(*sr);
   out.count = r.segments().now();

@@ -1,5 +1,5 @@
 // Binary checkpoints: header, sections, FNV-1a checksum.
-#include "regolith_twin/scene/checkpoint.hpp"
+#include "regolith_twin/io/checkpoint.hpp"
 
 #include <unistd.h>
 
@@ -16,7 +16,7 @@
 
 #include "regolith_twin/core/hash.hpp"
 #include "regolith_twin/core/neighbours.hpp"
-#include "regolith_twin/scene/data_file.hpp"
+#include "regolith_twin/io/data_file.hpp"
 
 namespace rt {
 namespace {

@@ -1,6 +1,6 @@
 // Reader of LAMMPS "atom_style sphere" data files (id type diameter density x y z),
 // and the size and nesting limits every file reader applies first.
-#include "regolith_twin/scene/data_file.hpp"
+#include "regolith_twin/io/data_file.hpp"
 
 #include <cerrno>
 #include <cstdlib>

@@ -1,5 +1,5 @@
 // Seeded grain generation.
-#include "regolith_twin/scene/generate.hpp"
+#include "regolith_twin/io/generate.hpp"
 #include "regolith_twin/core/types.hpp"
 
 #include <algorithm>

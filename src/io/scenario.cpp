@@ -1,6 +1,6 @@
 // Scenario files: YAML -> Model + initial State, with errors that name the
 // file, the key and the allowed range.
-#include "regolith_twin/scene/scenario.hpp"
+#include "regolith_twin/io/scenario.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -14,11 +14,11 @@
 #include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/core/field.hpp"
 #include "regolith_twin/core/walls.hpp"
-#include "regolith_twin/scene/data_file.hpp"
-#include "regolith_twin/scene/generate.hpp"
-#include "regolith_twin/scene/snapshot.hpp"
-#include "regolith_twin/scene/urdf_body.hpp"
-#include "regolith_twin/scene/yaml_reader.hpp"
+#include "regolith_twin/io/data_file.hpp"
+#include "regolith_twin/io/generate.hpp"
+#include "regolith_twin/io/snapshot.hpp"
+#include "regolith_twin/io/urdf_body.hpp"
+#include "regolith_twin/io/yaml_reader.hpp"
 
 namespace rt {
 namespace {

@@ -1,8 +1,8 @@
 // Compact bed snapshots, float32 or float64 (see snapshot.hpp).
-#include "regolith_twin/scene/snapshot.hpp"
+#include "regolith_twin/io/snapshot.hpp"
 
 #include "regolith_twin/core/hash.hpp"
-#include "regolith_twin/scene/data_file.hpp"
+#include "regolith_twin/io/data_file.hpp"
 
 #include <unistd.h>
 

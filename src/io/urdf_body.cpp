@@ -1,6 +1,6 @@
 // Rigid bodies from URDF: links merged through fixed joints into one body with
 // principal-axis frame, collision shapes and STL meshes (see urdf_body.hpp).
-#include "regolith_twin/scene/urdf_body.hpp"
+#include "regolith_twin/io/urdf_body.hpp"
 
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
@@ -19,7 +19,7 @@
 #include <mutex>
 #include <sstream>
 
-#include "regolith_twin/scene/data_file.hpp"
+#include "regolith_twin/io/data_file.hpp"
 
 namespace rt {
 namespace {

@@ -18,7 +18,7 @@
 #include "regolith_twin/BodyStates.h"
 #include "regolith_twin/scenes/landing/landing.hpp"
 #include "regolith_twin/run/series.hpp"
-#include "regolith_twin/scene/scenario.hpp"
+#include "regolith_twin/io/scenario.hpp"
 
 int main(int argc, char** argv) {
   std::string bag_path, file, topic = "/twin_node/body_states", body, out;

@@ -24,7 +24,7 @@
 #include "regolith_twin/Status.h"
 #include "regolith_twin/core/energy.hpp"
 #include "regolith_twin/run/series.hpp"
-#include "regolith_twin/scene/checkpoint.hpp"
+#include "regolith_twin/io/checkpoint.hpp"
 
 namespace rt_ros {
 namespace {

@@ -8,8 +8,8 @@
 
 #include "regolith_twin/core/hash.hpp"
 #include "regolith_twin/run/series.hpp"
-#include "regolith_twin/scene/checkpoint.hpp"
-#include "regolith_twin/scenes/scenario/scenario_scene.hpp"
+#include "regolith_twin/io/checkpoint.hpp"
+#include "regolith_twin/run/scenario_kind.hpp"
 
 namespace rt {
 namespace {

@@ -16,9 +16,9 @@
 
 #include "regolith_twin/run/scene.hpp"
 #include "regolith_twin/run/series.hpp"
-#include "regolith_twin/scene/checkpoint.hpp"
-#include "regolith_twin/scene/data_file.hpp"
-#include "regolith_twin/scene/snapshot.hpp"
+#include "regolith_twin/io/checkpoint.hpp"
+#include "regolith_twin/io/data_file.hpp"
+#include "regolith_twin/io/snapshot.hpp"
 
 namespace rt {
 namespace {

@@ -11,7 +11,7 @@
 #include "regolith_twin/core/energy.hpp"
 #include "regolith_twin/core/sleep.hpp"
 #include "regolith_twin/core/step.hpp"
-#include "regolith_twin/scene/snapshot.hpp"
+#include "regolith_twin/io/snapshot.hpp"
 
 namespace rt {
 

@@ -1,5 +1,5 @@
-// The plain scenario kind (see scenario_scene.hpp).
-#include "regolith_twin/scenes/scenario/scenario_scene.hpp"
+// The plain scenario kind (see scenario_kind.hpp).
+#include "regolith_twin/run/scenario_kind.hpp"
 
 #include <yaml-cpp/yaml.h>
 

@@ -8,7 +8,7 @@
 #include <mutex>
 
 #include "regolith_twin/scenes/registry.hpp"
-#include "regolith_twin/scenes/scenario/scenario_scene.hpp"
+#include "regolith_twin/run/scenario_kind.hpp"
 
 namespace rt {
 namespace {

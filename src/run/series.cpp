@@ -13,7 +13,7 @@
 #include <sstream>
 
 #include "regolith_twin/core/types.hpp"
-#include "regolith_twin/scene/data_file.hpp"
+#include "regolith_twin/io/data_file.hpp"
 
 namespace rt {
 namespace {

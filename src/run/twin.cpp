@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "regolith_twin/core/step.hpp"
-#include "regolith_twin/scene/checkpoint.hpp"
+#include "regolith_twin/io/checkpoint.hpp"
 
 namespace rt {
 namespace {

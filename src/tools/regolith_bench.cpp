@@ -22,8 +22,8 @@
 
 #include "regolith_twin/core/energy.hpp"
 #include "regolith_twin/core/step.hpp"
-#include "regolith_twin/scene/checkpoint.hpp"
-#include "regolith_twin/scene/scenario.hpp"
+#include "regolith_twin/io/checkpoint.hpp"
+#include "regolith_twin/io/scenario.hpp"
 
 namespace {
 

@@ -22,8 +22,8 @@
 
 #include "regolith_twin/core/body.hpp"
 #include "regolith_twin/core/walls.hpp"
-#include "regolith_twin/scene/generate.hpp"
-#include "regolith_twin/scene/scenario.hpp"
+#include "regolith_twin/io/generate.hpp"
+#include "regolith_twin/io/scenario.hpp"
 #include "test_support.hpp"
 
 namespace {

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "regolith_twin/core/walls.hpp"
-#include "regolith_twin/scene/generate.hpp"
+#include "regolith_twin/io/generate.hpp"
 #include "test_support.hpp"
 
 namespace {

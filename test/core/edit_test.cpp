@@ -13,7 +13,7 @@
 
 #include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/core/walls.hpp"
-#include "regolith_twin/scene/scenario.hpp"
+#include "regolith_twin/io/scenario.hpp"
 #include "test_support.hpp"
 
 namespace {

@@ -23,7 +23,7 @@
 
 #include "regolith_twin/core/field.hpp"
 #include "regolith_twin/core/walls.hpp"
-#include "regolith_twin/scene/generate.hpp"
+#include "regolith_twin/io/generate.hpp"
 #include "test_support.hpp"
 
 namespace {

@@ -20,8 +20,8 @@
 #include "regolith_twin/core/neighbours.hpp"
 #include "regolith_twin/core/step.hpp"
 #include "regolith_twin/core/walls.hpp"
-#include "regolith_twin/scene/checkpoint.hpp"
-#include "regolith_twin/scene/generate.hpp"
+#include "regolith_twin/io/checkpoint.hpp"
+#include "regolith_twin/io/generate.hpp"
 #include "test_support.hpp"
 
 namespace {

@@ -9,7 +9,7 @@
 #include "regolith_twin/core/field.hpp"
 #include "regolith_twin/core/gas.hpp"
 #include "regolith_twin/core/step.hpp"
-#include "regolith_twin/scene/generate.hpp"
+#include "regolith_twin/io/generate.hpp"
 #include "plume_gas.hpp"
 #include "test_support.hpp"
 

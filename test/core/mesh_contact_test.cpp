@@ -16,7 +16,7 @@
 #include "regolith_twin/core/body.hpp"
 #include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/core/mesh_contact.hpp"
-#include "regolith_twin/scene/checkpoint.hpp"
+#include "regolith_twin/io/checkpoint.hpp"
 #include "test_support.hpp"
 
 namespace {

@@ -16,8 +16,8 @@
 #include "regolith_twin/core/hash.hpp"
 #include "regolith_twin/core/sleep.hpp"
 #include "regolith_twin/core/walls.hpp"
-#include "regolith_twin/scene/checkpoint.hpp"
-#include "regolith_twin/scene/generate.hpp"
+#include "regolith_twin/io/checkpoint.hpp"
+#include "regolith_twin/io/generate.hpp"
 #include "test_support.hpp"
 
 namespace {

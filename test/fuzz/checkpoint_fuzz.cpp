@@ -11,8 +11,8 @@
 #include "fuzz_support.hpp"
 #include "regolith_twin/core/hash.hpp"
 #include "regolith_twin/core/step.hpp"
-#include "regolith_twin/scene/checkpoint.hpp"
-#include "regolith_twin/scene/scenario.hpp"
+#include "regolith_twin/io/checkpoint.hpp"
+#include "regolith_twin/io/scenario.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const rt::Scenario sc =

@@ -9,7 +9,7 @@
 #include <cstdint>
 
 #include "fuzz_support.hpp"
-#include "regolith_twin/scene/scenario.hpp"
+#include "regolith_twin/io/scenario.hpp"
 #include "regolith_twin/scenes/landing/landing.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

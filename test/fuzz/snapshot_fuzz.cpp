@@ -7,7 +7,7 @@
 
 #include "fuzz_support.hpp"
 #include "regolith_twin/core/hash.hpp"
-#include "regolith_twin/scene/snapshot.hpp"
+#include "regolith_twin/io/snapshot.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::string bytes(reinterpret_cast<const char*>(data), size);

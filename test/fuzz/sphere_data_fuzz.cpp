@@ -3,7 +3,7 @@
 #include <cstdint>
 
 #include "fuzz_support.hpp"
-#include "regolith_twin/scene/data_file.hpp"
+#include "regolith_twin/io/data_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path = rt::fuzz::write(rt::fuzz::scratch() / "grains.data",

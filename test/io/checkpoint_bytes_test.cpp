@@ -8,7 +8,7 @@
 #include <iterator>
 #include <string>
 
-#include "regolith_twin/scene/checkpoint.hpp"
+#include "regolith_twin/io/checkpoint.hpp"
 #include "test_support.hpp"
 
 namespace {

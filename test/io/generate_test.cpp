@@ -10,8 +10,8 @@
 #include <fstream>
 #include <random>
 
-#include "regolith_twin/scene/generate.hpp"
-#include "regolith_twin/scene/scenario.hpp"
+#include "regolith_twin/io/generate.hpp"
+#include "regolith_twin/io/scenario.hpp"
 
 namespace {
 

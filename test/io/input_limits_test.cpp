@@ -11,11 +11,11 @@
 #include <functional>
 #include <string>
 
-#include "regolith_twin/scene/checkpoint.hpp"
-#include "regolith_twin/scene/data_file.hpp"
-#include "regolith_twin/scene/scenario.hpp"
-#include "regolith_twin/scene/snapshot.hpp"
-#include "regolith_twin/scene/urdf_body.hpp"
+#include "regolith_twin/io/checkpoint.hpp"
+#include "regolith_twin/io/data_file.hpp"
+#include "regolith_twin/io/scenario.hpp"
+#include "regolith_twin/io/snapshot.hpp"
+#include "regolith_twin/io/urdf_body.hpp"
 
 namespace {
 

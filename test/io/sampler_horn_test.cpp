@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "regolith_twin/scene/urdf_body.hpp"
+#include "regolith_twin/io/urdf_body.hpp"
 
 namespace {
 

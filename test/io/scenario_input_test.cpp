@@ -23,8 +23,8 @@
 #include <vector>
 
 #include "regolith_twin/run/series.hpp"
-#include "regolith_twin/scenes/scenario/scenario_scene.hpp"
-#include "regolith_twin/scene/scenario.hpp"
+#include "regolith_twin/run/scenario_kind.hpp"
+#include "regolith_twin/io/scenario.hpp"
 #include "test_support.hpp"
 
 namespace {

@@ -17,7 +17,7 @@
 
 #include "regolith_twin/core/types.hpp"
 #include "regolith_twin/run/series.hpp"
-#include "regolith_twin/scene/data_file.hpp"
+#include "regolith_twin/io/data_file.hpp"
 
 namespace {
 

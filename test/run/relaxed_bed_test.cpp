@@ -10,7 +10,7 @@
 
 #include "regolith_twin/core/types.hpp"
 #include "regolith_twin/run/bed_cache.hpp"
-#include "regolith_twin/scene/scenario.hpp"
+#include "regolith_twin/io/scenario.hpp"
 
 namespace {
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "regolith_twin/run/run.hpp"
-#include "regolith_twin/scene/checkpoint.hpp"
+#include "regolith_twin/io/checkpoint.hpp"
 #include "test_support.hpp"
 
 namespace {

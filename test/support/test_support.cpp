@@ -1,7 +1,7 @@
 #include "test_support.hpp"
 
 #include "regolith_twin/core/walls.hpp"
-#include "regolith_twin/scene/scenario.hpp"
+#include "regolith_twin/io/scenario.hpp"
 
 #include <unistd.h>
 

@@ -1,6 +1,6 @@
 // Static description of a DEM scene: grain sizes and masses, materials, the
 // contact-law table for every pair type, walls, gravity, time step and guard
-// thresholds. A Model is built once (by the scenario reader, src/scene/scenario.cpp) and is then
+// thresholds. A Model is built once (by the scenario reader, src/io/scenario.cpp) and is then
 // read-only: every stage of the step takes `const Model&` and a mutable State.
 #pragma once
 

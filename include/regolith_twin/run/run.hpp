@@ -23,7 +23,7 @@
 #include "regolith_twin/core/step.hpp"
 #include "regolith_twin/run/observer.hpp"
 #include "regolith_twin/run/series.hpp"
-#include "regolith_twin/scene/scenario.hpp"
+#include "regolith_twin/io/scenario.hpp"
 
 namespace rt {
 

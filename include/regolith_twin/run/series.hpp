@@ -37,7 +37,7 @@ class OutputFolder {
 // long run rather than at its end.
 void check_writable(const std::string& path);
 
-// Write `text` as write_file_replacing does (regolith_twin/scene/data_file.hpp),
+// Write `text` as write_file_replacing does (regolith_twin/io/data_file.hpp),
 // without waiting for the disk: a run killed or stopped by a full disk leaves
 // the previous file or none, never part of one.
 void write_file(const std::string& path, const std::string& text);

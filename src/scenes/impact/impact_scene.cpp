@@ -13,7 +13,7 @@
 #include "regolith_twin/core/body.hpp"
 #include "regolith_twin/run/bed_cache.hpp"
 #include "regolith_twin/run/series.hpp"
-#include "regolith_twin/scene/yaml_reader.hpp"
+#include "regolith_twin/io/yaml_reader.hpp"
 
 namespace rt {
 namespace {

@@ -12,7 +12,7 @@
 #include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/run/bed_cache.hpp"
 #include "regolith_twin/run/series.hpp"
-#include "regolith_twin/scene/yaml_reader.hpp"
+#include "regolith_twin/io/yaml_reader.hpp"
 
 namespace rt {
 namespace {

@@ -17,7 +17,7 @@
 #include "regolith_twin/core/energy.hpp"
 #include "regolith_twin/core/step.hpp"
 #include "regolith_twin/run/series.hpp"
-#include "regolith_twin/scene/yaml_reader.hpp"
+#include "regolith_twin/io/yaml_reader.hpp"
 #include "regolith_twin/scenes/landing/landing_scene.hpp"
 
 namespace rt {

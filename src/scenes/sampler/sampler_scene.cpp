@@ -11,7 +11,7 @@
 #include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/observers/escape.hpp"
 #include "regolith_twin/run/bed_cache.hpp"
-#include "regolith_twin/scene/yaml_reader.hpp"
+#include "regolith_twin/io/yaml_reader.hpp"
 #include "regolith_twin/scenes/sampler/crater.hpp"
 #include "regolith_twin/scenes/sampler/horn_segments.hpp"
 #include "regolith_twin/scenes/sampler/impact_observers.hpp"

@@ -6,7 +6,7 @@
 #include <sstream>
 #include <string>
 
-#include "regolith_twin/scene/scenario.hpp"
+#include "regolith_twin/io/scenario.hpp"
 
 namespace rt::test {
 

@@ -12,7 +12,7 @@
 #include <regex>
 #include <sstream>
 
-#include "regolith_twin/scene/checkpoint.hpp"
+#include "regolith_twin/io/checkpoint.hpp"
 #include "regolith_twin/scenes/sampler/sampler_scene.hpp"
 #include "test_support.hpp"
 

@@ -1,4 +1,4 @@
-// The landing's ROS topics (see include/regolith_twin/ros/scenes/).
+// The landing's ROS topics (see regolith_twin/ros/scenes/landing.hpp).
 #include "regolith_twin/ros/scenes/landing.hpp"
 
 #include <cstdio>

@@ -1,4 +1,4 @@
-// The sampler's ROS topics (see include/regolith_twin/ros/scenes/).
+// The sampler's ROS topics (see regolith_twin/ros/scenes/sampler.hpp).
 #include "regolith_twin/ros/scenes/sampler.hpp"
 
 #include <cstdio>

@@ -6,10 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 #include "regolith_twin/core/model.hpp"
 #include "regolith_twin/run/run.hpp"
 #include "regolith_twin/scenes/incline/incline_scene.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -156,12 +158,9 @@ std::unique_ptr<rt::Scene> rain_scene(const std::vector<std::string>& extra, rt:
   auto sc = rt::load_scene("config/incline_rain.yaml", set, o);
   m = sc->sc.model;
   s = sc->start;
-  rt::RunOptions ro;
-  ro.progress_every = 0;
-  rt::Run run(m, s, sc->plan, ro);
-  sr = sc->begin(run);
-  for (rt::Observer* ob : sr->observers()) run.add_observer(ob);
-  rep = run.run();
+  rt::test::SceneRunOutcome ran = rt::test::run_scene(*sc, m, s);
+  sr = std::move(ran.run);
+  rep = ran.report;
   return sc;
 }
 

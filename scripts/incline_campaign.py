@@ -7,7 +7,8 @@
 Runs: onset_MAT (1-degree steps from rest, MAT = moderate or gravel), MAT_ANGLE
 (flow at a fixed ANGLE: profiles over the last second, Bagnold fit, I) and rain_MAT_ANGLE (the
 published protocol, config/incline_rain.yaml: grains rained onto the plane tilted at ANGLE, 8 s,
-flowing or not over the last 2 s; the onset is the smallest angle that flows). A
+flowing or not over the last 2 s, or ended early once every grain is at rest; the onset is the
+smallest angle that flows). A
 finished run's summary.json (with profile.csv and series.csv) goes to DOCS/RUN/ (committed:
 a campaign resumes on any machine; INCLINE_RERUN=1 runs them again); a run
 that stopped leaves failed.txt there, not retried.
@@ -247,7 +248,11 @@ def report(docs):
             continue
         o = done[n]["observers"]["incline"]
         w = done[n]["campaign"]["wall_seconds"]
-        if o["mode"] == "rain":
+        if o["mode"] == "rain" and o.get("stopped_at_rest"):
+            res = "at rest at %.2f s (every grain slower than 0.01 sqrt(g d) for 0.25 s; the run ends there): " \
+                  "not flowing, mean v_x %.3g m/s, trend %+.3g m/s²; %d glued" % (
+                      o["rest_time"], o["end_mean_vx"], o["end_dvdt"], o["glued_grains"])
+        elif o["mode"] == "rain":
             res = "%s: mean v_x %.3g m/s at the end, trend %+.3g m/s² over the last 2 s; %d glued; A = %.4g m/s, " \
                   "h = %.1f d, Phi = %.3f, I = %.4g" % (
                       "flowing" if o["flowing"] else "not flowing", o["end_mean_vx"], o["end_dvdt"],

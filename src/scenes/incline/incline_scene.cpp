@@ -31,7 +31,7 @@ InclineSpec parse_incline(const YAML::Node& n, const std::string& src) {
   const std::string p = "incline";
   if (!n || !n.IsMap()) rd.fail(p, "missing or not a mapping");
   rd.only(n, p, {"mode", "angle_deg", "start_deg", "step_deg", "max_deg", "hold", "flow_speed", "duration", "average",
-                 "layer", "sample_every"});
+                 "layer", "sample_every", "rest_speed", "rest_hold"});
   const std::string mode = rd.text(n, p, "mode", "steady");
   if (mode != "steady" && mode != "onset" && mode != "rain")
     rd.fail(p + ".mode", "expected steady, onset or rain, got '" + mode + "'");
@@ -47,6 +47,9 @@ InclineSpec parse_incline(const YAML::Node& n, const std::string& src) {
   sp.average = rd.number(n, p, "average", sp.average, 0, sp.duration, true);
   sp.layer = rd.number(n, p, "layer", sp.layer, 0, 1, true);
   sp.sample_every = rd.number(n, p, "sample_every", sp.sample_every, 0, 1e3, true);
+  sp.rest_speed = rd.number(n, p, "rest_speed", sp.rest_speed, 0, 10);
+  sp.rest_hold = rd.number(n, p, "rest_hold", sp.rest_hold, 0, sp.duration, true);
+  if (sp.rest_speed > 0 && mode != "rain") rd.fail(p + ".rest_speed", "applies to mode rain only");
   return sp;
 }
 
@@ -163,10 +166,11 @@ bool InclineObserver::after_step(Model& m, State& s) {
       }
     if (glued) s.rebuild_requested = true;  // pair constants (m*) and partitions follow
   }
+  const long every = std::max(1L, std::lround(0.01 / m.dt));
+  if (sp_.rain && sp_.rest_speed > 0 && s.step % every == 0 && at_rest_check(m, s)) return true;
   // Steady and rain: sample the layers every sample interval over the last `average` s.
   const double t_end = sp_.duration;
   if (s.time < t_end - sp_.average) return false;
-  const long every = std::max(1L, std::lround(0.01 / m.dt));
   if (s.step % every != 0) return false;
   if (sp_.rain) {
     if (!window_started_) find_layers(m, s);
@@ -184,6 +188,24 @@ bool InclineObserver::after_step(Model& m, State& s) {
   }
   ++samples_;
   return false;
+}
+
+bool InclineObserver::at_rest_check(const Model& m, const State& s) {
+  const double limit = sp_.rest_speed * std::sqrt(g_ * d_);
+  double v2 = 0;
+  for (int i = 0; i < m.n_grains; ++i)
+    if (m.grain_inv_mass[i] != 0) v2 = std::max(v2, s.vel[i].squaredNorm());
+  if (!(v2 < limit * limit)) {
+    rest_t_.clear();
+    rest_v_.clear();
+    return false;
+  }
+  rest_t_.push_back(s.time);
+  rest_v_.push_back(mean_vx(m, s));
+  if (s.time - rest_t_.front() < sp_.rest_hold - 0.5 * m.dt) return false;
+  rested_ = true;
+  rest_time_ = s.time;
+  return true;
 }
 
 void InclineObserver::find_layers(const Model& m, const State& s) {
@@ -208,7 +230,12 @@ void InclineObserver::find_layers(const Model& m, const State& s) {
 }
 
 void InclineObserver::finish(Model& m, State& s) {
-  if (sp_.rain && !win_t_.empty()) {
+  if (sp_.rain && rested_) {
+    // Every free grain at rest for rest_hold s: not flowing; the end state is read over that hold.
+    end_vx_ = rest_v_.back();
+    end_dvdt_ = trend(rest_t_, rest_v_);
+    flowing_ = false;
+  } else if (sp_.rain && !win_t_.empty()) {
     end_vx_ = win_v_.back();
     end_dvdt_ = trend(win_t_, win_v_);
     flowing_ = onset_flowing(end_vx_, end_dvdt_, sp_.average, sp_.flow_speed * std::sqrt(g_ * d_));
@@ -251,6 +278,7 @@ void InclineObserver::summary(JsonObject& out) const {
   if (sp_.rain) {
     o.num("glued_grains", glued_).num("end_mean_vx", end_vx_).num("end_dvdt", end_dvdt_);
     o.boolean("flowing", flowing_).num("base_top", base_).num("bed_top", top_);
+    if (sp_.rest_speed > 0) o.boolean("stopped_at_rest", rested_).num("rest_time", rested_ ? rest_time_ : -1);
   }
   if (sp_.onset) {
     o.num("onset_deg", onset_deg_);
@@ -333,7 +361,8 @@ std::string InclineRun::result_line(const Model& m, const State& s, const RunRep
     std::snprintf(b, sizeof b,
                   "incline %s: rained at %.1f deg: %s (mean v_x %.4g m/s, trend %.3g m/s^2; %d grains glued), "
                   "Bagnold A = %.4g m/s, I = %.4g (%.0f s wall)",
-                  scene_.sc.name.c_str(), o.theta_deg(), o.flowing() ? "flowing" : "at rest or stopping",
+                  scene_.sc.name.c_str(), o.theta_deg(),
+                  o.flowing() ? "flowing" : o.rested() ? "at rest (every grain slow; run ended)" : "at rest or stopping",
                   o.end_vx(), o.end_dvdt(), o.glued(), o.profile().bagnold_a, o.profile().inertial_number,
                   rep.wall_seconds);
   else

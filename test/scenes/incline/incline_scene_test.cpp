@@ -206,7 +206,56 @@ TEST(InclineRain, SteepEnoughTheDepositFlows) {
   EXPECT_GT(ob.profile().height, 0.0);
 }
 
+TEST(InclineRain, TheRestStopEndsARestingDepositWithTheFullRunsVerdict) {
+  // 150 grains at 20 degrees, 1 s: the full run and the run that ends once every grain has been slow for 0.1 s
+  // (at 0.82 s) agree that the deposit does not flow; the stopped run ends before the full one, with its end
+  // speed below the rest limit (0.01 sqrt(g d)) and the full run's end speed below that limit too.
+  rt::Model m1, m2;
+  rt::State s1, s2;
+  std::unique_ptr<rt::SceneRun> r1, r2;
+  rt::RunReport rep1, rep2;
+  const std::vector<std::string> small = {"grains.0.fill.count=150", "grains.0.fill.hi=[0.20,0.10,0.06]",
+                                          "incline.angle_deg=20", "incline.duration=1.0"};
+  std::vector<std::string> full_run = small, stopped = small;
+  full_run.push_back("incline.rest_speed=0");
+  stopped.insert(stopped.end(), {"incline.rest_speed=0.01", "incline.rest_hold=0.1"});
+  rain_scene(full_run, m1, s1, r1, rep1);
+  rain_scene(stopped, m2, s2, r2, rep2);
+  ASSERT_EQ(rep1.status, "ok") << rep1.message;
+  ASSERT_EQ(rep2.status, "ok") << rep2.message;
+  const auto& full = static_cast<rt::InclineRun&>(*r1).observer();
+  const auto& stop = static_cast<rt::InclineRun&>(*r2).observer();
+  EXPECT_FALSE(full.rested());
+  ASSERT_TRUE(stop.rested());
+  EXPECT_LT(stop.rest_time(), 0.95);
+  // What the stop leaves out: the deposit moves by less than 1 % of a diameter between the stop and 1 s.
+  ASSERT_EQ(m1.n_grains, m2.n_grains);
+  double moved = 0;
+  for (int i = 0; i < m1.n_grains; ++i) moved = std::max(moved, (s1.pos[i] - s2.pos[i]).norm());
+  EXPECT_LT(moved, 1e-4);
+  EXPECT_NEAR(s2.time, stop.rest_time(), 1e-9);
+  EXPECT_EQ(full.flowing(), stop.flowing());
+  EXPECT_FALSE(stop.flowing());
+  const double limit = 0.01 * std::sqrt(9.81 * 0.01);
+  EXPECT_LT(std::abs(stop.end_vx()), limit);
+  EXPECT_LT(std::abs(full.end_vx()), limit);
+}
+
+TEST(InclineRain, TheRestStopStaysOffWhileTheDepositFlows) {
+  rt::Model m;
+  rt::State s;
+  std::unique_ptr<rt::SceneRun> sr;
+  rt::RunReport rep;
+  rain_scene({"incline.angle_deg=60", "incline.rest_speed=0.01"}, m, s, sr, rep);
+  ASSERT_EQ(rep.status, "ok") << rep.message;
+  const auto& ob = static_cast<rt::InclineRun&>(*sr).observer();
+  EXPECT_FALSE(ob.rested());
+  EXPECT_TRUE(ob.flowing());
+  EXPECT_NEAR(s.time, 0.5, 1e-6);
+}
+
 TEST(InclineRain, BadInputIsRefused) {
+  expect_refused("config/incline_moderate.yaml", {"incline.rest_speed=0.01"}, "mode rain only");
   expect_refused("config/incline_rain.yaml", {"grains.0.fixed=true"}, "fixed");
   expect_refused("config/incline_rain.yaml", {"walls=[]"}, "plane floor");
 }

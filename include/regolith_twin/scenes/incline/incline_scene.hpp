@@ -20,6 +20,10 @@
 //                last `average` s ends above `flow_speed` sqrt(g d) and, at
 //                its trend over that window, stays above it for one more
 //                window; the profiles and Bagnold fit as in steady mode.
+//                With `rest_speed` > 0 the run ends early once every free
+//                grain has stayed slower than `rest_speed` sqrt(g d) for
+//                `rest_hold` s (checked every 0.01 s): the deposit is at rest,
+//                not flowing, and its end state is read over that hold.
 #pragma once
 
 #include <memory>
@@ -40,6 +44,8 @@ struct InclineSpec {
   double average = 1.0;        // steady: the last s averaged
   double layer = 0.01;         // layer thickness of the profiles, m
   double sample_every = 0.01;  // s between rows of series.csv
+  double rest_speed = 0;       // rain: end once every free grain is slower than this many sqrt(g d) (0: never)
+  double rest_hold = 0.25;     // rain: ... for this long, s
 };
 
 // Velocity and packing profiles (layers from the base's top) and the Bagnold fit.
@@ -86,10 +92,14 @@ class InclineObserver : public Observer {
   double end_dvdt() const { return end_dvdt_; }
   bool flowing() const { return flowing_; }
   int glued() const { return glued_; }
+  // rain with rest_speed > 0: whether the run ended with the deposit at rest, and when (s).
+  bool rested() const { return rested_; }
+  double rest_time() const { return rest_time_; }
 
  private:
   void tilt(Model& m, State& s, double deg);
   void find_layers(const Model& m, const State& s);  // rain: base and top at the start of the window
+  bool at_rest_check(const Model& m, const State& s);  // rain: true once every free grain is slow for rest_hold s
   InclineSpec sp_;
   double base_, top_, d_, area_, g_, floor_;
   int glued_ = 0;                 // rain: grains glued to the plane
@@ -97,6 +107,9 @@ class InclineObserver : public Observer {
   std::vector<double> win_t_, win_v_;  // rain: mean v_x every 0.01 s over the window
   double end_vx_ = 0, end_dvdt_ = 0;
   bool flowing_ = false;
+  std::vector<double> rest_t_, rest_v_;  // rain: mean v_x every 0.01 s since every free grain became slow
+  bool rested_ = false;
+  double rest_time_ = 0;
   static constexpr double kTrendWindow = 0.25;  // onset: the hold-end trend is read over this fraction of the hold
   struct Hold {
     double theta_deg, v_end, dvdt_end;  // the tilt, mean v_x at the end of its hold, and its trend there

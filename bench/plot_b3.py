@@ -5,7 +5,8 @@ off, one bed: horn-segment counts, crater depth and ejected grains over time
 
     bench/plot_b3.py REF_DIR SCHEDULE_DIR OUT.png [T ...]
 """
-import csv
+import argparse
+import os
 import sys
 
 import matplotlib
@@ -13,9 +14,12 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scripts", "lib"))
+from csv_columns import read_rows  # noqa: E402
+
 
 def series(d):
-    rows = list(csv.DictReader(open(d + "/series.csv")))
+    rows = read_rows(os.path.join(d, "series.csv"))
     return {k: [float(r[k]) for r in rows] for k in rows[0]}
 
 
@@ -24,9 +28,15 @@ def at(s, key, t):
     return s[key][i]
 
 
-ref, sch = series(sys.argv[1]), series(sys.argv[2])
-out = sys.argv[3]
-times = [float(x) for x in sys.argv[4:]] or [0.05, 0.1, 0.2]
+ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap.add_argument("ref", metavar="REF_DIR")
+ap.add_argument("schedule", metavar="SCHEDULE_DIR")
+ap.add_argument("out", metavar="OUT.png")
+ap.add_argument("times", metavar="T", type=float, nargs="*", default=[0.05, 0.1, 0.2])
+args = ap.parse_args()
+ref, sch = series(args.ref), series(args.schedule)
+out = args.out
+times = args.times
 t_end = min(ref["t"][-1], sch["t"][-1])
 fig, ax = plt.subplots(1, 3, figsize=(13, 3.8))
 for k, c in zip(range(1, 4), ["C0", "C1", "C2"]):

@@ -4,9 +4,9 @@ docs/benchmarks.md figures: medians, ratios and a bar plot.
 
 usage: report_b1.py RAW_LINES_FILE PLOT_PNG > table.md
 """
+import argparse
 import re
 import statistics
-import sys
 from collections import defaultdict
 
 
@@ -24,7 +24,11 @@ def parse(path):
 
 
 def main():
-    raw, png = sys.argv[1], sys.argv[2]
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("raw", metavar="RAW_LINES_FILE")
+    p.add_argument("png", metavar="PLOT_PNG")
+    a = p.parse_args()
+    raw, png = a.raw, a.png
     rows = parse(raw)
     speed = defaultdict(list)  # (engine, threads) -> particle-steps/s of each block
     by_round = {}  # (engine, threads, round) -> particle-steps/s (interleaved rounds)

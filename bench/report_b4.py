@@ -7,6 +7,7 @@ not) and draws the error against wall time (docs/bench/b4_landing.png).
 
     bench/report_b4.py [SETTING ...]        default: preview
 """
+import argparse
 import glob
 import json
 import math
@@ -14,6 +15,9 @@ import os
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
+from stats import mean_sd  # noqa: E402
+
 KEEP = os.path.join(ROOT, "docs", "bench", "b4")
 # output key, label, margin, relative margin?
 OUTPUTS = [("speed_ratio", "speed ratio", 0.05, False),
@@ -35,7 +39,9 @@ def sim_time(s):
 
 
 def main():
-    settings = sys.argv[1:] or ["preview"]
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("settings", metavar="SETTING", nargs="*", default=["preview"])
+    settings = p.parse_args().settings
     ref = load("ref")
     lines = []
     vals = {k: [ref[r]["outcome"][k] for r in sorted(ref)] for k, *_ in OUTPUTS}
@@ -102,14 +108,12 @@ def draw(plot, ref_wall):
 
 
 def mean(x):
-    return sum(x) / len(x)
+    return mean_sd(x)[0]
 
 
 def sd(x):
-    if len(x) < 2:
-        return float("inf")
-    m = mean(x)
-    return math.sqrt(sum((v - m) ** 2 for v in x) / (len(x) - 1))
+    """The sample SD; infinite for fewer than two values (no confidence interval)."""
+    return mean_sd(x, missing=float("inf"))[1]
 
 
 def fmt_wall(runs, pairs):

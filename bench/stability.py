@@ -11,11 +11,10 @@ again); then OUT_DIR/stability.md and OUT_DIR/stability.png. The runs' own
 outputs go to $STABILITY_WORK (default out/stability). BIN is the folder of
 the tools (default build/devel/lib/regolith_twin); STABILITY_THREADS (1).
 """
+import argparse
 import json
 import os
-import re
 import subprocess
-import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -288,8 +287,14 @@ def report(out):
 
 
 def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "docs/bench/stability")
-    scenes = sys.argv[2:] or ["box", "mascot", "sampler"]
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("out", metavar="OUT", nargs="?", default=os.path.join(ROOT, "docs/bench/stability"))
+    p.add_argument("scenes", metavar="SCENE", nargs="*", help="box, mascot or sampler (default: all three)")
+    a = p.parse_args()
+    out, scenes = a.out, a.scenes or ["box", "mascot", "sampler"]
+    for sc in scenes:
+        if sc not in ("box", "mascot", "sampler"):
+            p.error("unknown scene '%s' (box, mascot, sampler)" % sc)
     os.makedirs(out, exist_ok=True)
     for sc in scenes:
         {"box": sweep_box, "mascot": sweep_mascot, "sampler": sweep_sampler}[sc](out)

@@ -17,12 +17,15 @@ them); BUCKET_THREADS threads per run (default 1). Runs on the beds of the latti
 the beds were generated at random) are kept in DOCS/lattice_beds/ as evidence; they are not read.
 """
 import json
-import math
 import os
 import sys
 
+import numpy as np
+
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
 import campaign_cli  # noqa: E402
+import csv_columns  # noqa: E402
+import stats  # noqa: E402
 
 CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "bucket_impact.yaml")
 SPEEDS = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0]
@@ -57,11 +60,6 @@ def read_json(path):
         return json.load(f)
 
 
-def read_lines(path):
-    with open(path) as f:
-        return f.readlines()
-
-
 def run_name(bed, v, aim=0):
     return "%s_v%.2f%s" % (bed, v, "_a%d" % aim if aim else "")
 
@@ -85,50 +83,18 @@ def run_one(bin_dir, out, docs, bed, v, threads, aim=0):
                         s["campaign"]["wall_seconds"]), flush=True)
 
 
-def mean_sd(xs):
-    n = len(xs)
-    if n == 0:
-        return float("nan"), float("nan")
-    m = sum(xs) / n
-    return m, (math.sqrt(sum((x - m) ** 2 for x in xs) / (n - 1)) if n > 1 else float("nan"))
-
-
-def power_fit(xs, ys):
-    """y = A x^alpha by least squares in logs: (A, alpha)."""
-    lx = [math.log(x) for x in xs]
-    ly = [math.log(y) for y in ys]
-    n = len(lx)
-    mx, my = sum(lx) / n, sum(ly) / n
-    sxx = sum((a - mx) ** 2 for a in lx)
-    alpha = sum((a - mx) * (b - my) for a, b in zip(lx, ly)) / sxx
-    return math.exp(my - alpha * mx), alpha
-
-
 def law_fit(vs, ps, m=1.0, g=9.81):
     """The force law m a = -m g + f0 + m v^2/d1 fitted across impacts: the stopping depth of a
     sphere entering at V, p(V) = (d1/2) ln(1 + V^2 / ((f0/m - g) d1)) (V^2 / (2 (f0/m - g)) as 1/d1 -> 0)
-    by least squares, on a grid of log f0 and 1/d1 >= 0 refined twice around its best: (f0, 1/d1, rms)."""
-    def r2(lf, k):
-        c = 10 ** lf / m - g
-        if c <= 0 or k < 0:
-            return float("inf")
-        e = 0.0
-        for v, p in zip(vs, ps):
-            x = v * v / c
-            e += ((0.5 * x if k == 0 else 0.5 / k * math.log1p(x * k)) - p) ** 2
-        return e
+    by bounded least squares in c = f0/m - g > 0 and 1/d1 >= 0: (f0, 1/d1, rms)."""
+    def depth(v, p):
+        c, k = p
+        x = v * v / c
+        return np.where(k > 1e-12, np.log1p(x * max(k, 1e-12)) / (2 * max(k, 1e-12)), 0.5 * x)
 
-    lf0, dlf, k0, dk = 2.5, 1.5, 500.0, 500.0  # f0 in 10 .. 1e4 N, 1/d1 in 0 .. 1000 1/m
-    best = None
-    for _ in range(3):
-        for i in range(81):
-            for j in range(81):
-                lf, k = lf0 - dlf + 2 * dlf * i / 80, k0 - dk + 2 * dk * j / 80
-                e = r2(lf, k)
-                if best is None or e < best[2]:
-                    best = (lf, k, e)
-        lf0, k0, dlf, dk = best[0], best[1], dlf / 20, dk / 20
-    return 10 ** best[0], best[1], math.sqrt(best[2] / len(vs))
+    start_c = float(np.median([v * v / (2 * p) for v, p in zip(vs, ps)]))  # the 1/d1 = 0 estimate
+    (c, k), rms = stats.curve_fit(depth, vs, ps, [start_c, 1.0], [1e-9, 0.0], [np.inf, 1e4])
+    return m * (c + g), k, rms
 
 
 def load(docs):
@@ -156,10 +122,10 @@ def late_sinking(docs, s):
     path = os.path.join(docs, name, "impact.csv")
     if not os.path.exists(path):
         return float("nan")
-    rows = [[float(x) for x in r.split(",")] for r in read_lines(path) if r[0].isdigit()]
-    t_end = rows[-1][0]
-    before = max(r[1] for r in rows if r[0] <= t_end - 0.1) if t_end > 0.1 else 0.0
-    return max(r[1] for r in rows) - before
+    c = csv_columns.read_csv(path)
+    t, depth = c["t"], c["depth"]
+    before = float(depth[t <= t[-1] - 0.1].max()) if t[-1] > 0.1 else 0.0
+    return float(depth.max()) - before
 
 
 def at_speed(d, v, key="stopping_depth"):
@@ -176,7 +142,7 @@ def bed_figures(d):
     sw = sorted(d["sweep"], key=lambda s: s["input"]["speed"])
     ok = [(s["result"]["total_drop_height"], s["result"]["stopping_depth"]) for s in sw
           if s["result"]["stopping_depth"] > 0]
-    f["alpha"] = power_fit(*zip(*ok))[1] if len(ok) >= 3 else float("nan")
+    f["alpha"] = stats.power_fit(*zip(*ok))[1] if len(ok) >= 3 else float("nan")
     f["alpha_speeds"] = len(ok)
     f["bounced"] = sum(1 for s in runs if s["result"]["bounced"])
     f["bounced_1mm_s"] = sum(1 for s in runs if s["result"].get("bounced_1mm_s"))
@@ -202,7 +168,7 @@ def report(docs):
              "than 0.1 mm, or the sphere moves up faster than 1 cm/s; the variant: faster than 1 mm/s. Durations "
              "from the first contact force until |v_z| < 1 cm/s and < 1 mm/s. f₀, 1/d₁ across speeds: the law "
              "m a = −m g + f₀ + m v²/d₁, whose stopping depth for a sphere entering at V is "
-             "(d₁/2) ln(1 + V²/((f₀/m − g) d₁)), fitted to every run's z_stop (least squares on a grid, 1/d₁ ≥ 0).",
+             "(d₁/2) ln(1 + V²/((f₀/m − g) d₁)), fitted to every run's z_stop (bounded least squares, 1/d₁ ≥ 0).",
              "", "Aim points: 1 cm off the axis at 0°, 120° and 240°; at 0.5 and 1.0 m/s the axis run of the ten "
              "speeds joins them.", "",
              "| bed | grains (published) | bulk density at H (kg/m³) | packing at H | runs | α | f₀, 1/d₁ across runs "
@@ -233,8 +199,8 @@ def report(docs):
             zs = at_speed(d, v)
             if not zs:
                 continue
-            m, sd = mean_sd(zs)
-            mt, _ = mean_sd(at_speed(d, v, "stopping_depth_mean_top"))
+            m, sd = stats.mean_sd(zs)
+            mt, _ = stats.mean_sd(at_speed(d, v, "stopping_depth_mean_top"))
             nb = sum(1 for x in at_speed(d, v, "bounced") if x)
             ax[0].errorbar([v], [100 * m], yerr=[100 * sd if sd == sd else 0], fmt="s", color=line.get_color(),
                            capsize=3)

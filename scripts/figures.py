@@ -11,6 +11,7 @@ yet; `command` the command that produces the runs. Units SI (m, s, kg/m^3), angl
 collected masses in mg. Every figure is computed here from the results under docs/validation/
 (never typed in); the ids are those of ids() below.
 """
+import argparse
 import csv
 import glob
 import io
@@ -25,6 +26,7 @@ OUT = os.path.join(DOCS, "figures.csv")
 REPRO = os.path.join(ROOT, "docs", "reproduction.md")
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
+from stats import describe  # noqa: E402
 
 
 def read_text(path):
@@ -97,14 +99,9 @@ def ids():
 
 
 def stats(xs):
-    """(mean, sd or None, n) of a list of numbers."""
-    xs = [float(x) for x in xs if x is not None and x == x]
-    n = len(xs)
-    if n == 0:
-        return None, None, 0
-    m = sum(xs) / n
-    sd = math.sqrt(sum((x - m) ** 2 for x in xs) / (n - 1)) if n > 1 else None
-    return m, sd, n
+    """(mean, sd or None, n) of a list of numbers (None and NaN left out)."""
+    d = describe(xs)
+    return (None, None, 0) if d is None else (d["mean"], d["sd"], d["n"])
 
 
 def load_json(path):
@@ -489,7 +486,10 @@ def main():
     rows = table()
     text = render(rows)
     page = reproduction(rows)
-    if len(sys.argv) > 1 and sys.argv[1] == "--check":
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--check", action="store_true",
+                   help="write nothing; fail if the committed table or page differ from what the results give")
+    if p.parse_args().check:
         for path, want in ((OUT, text), (REPRO, page)):
             old = read_text(path) if os.path.exists(path) else ""
             if old != want:

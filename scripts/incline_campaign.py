@@ -23,6 +23,8 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
 import campaign_cli  # noqa: E402
+import csv_columns  # noqa: E402
+import stats  # noqa: E402
 
 CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "incline_moderate.yaml")
 DOCS_DEFAULT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "validation", "incline")
@@ -97,28 +99,20 @@ I_PLOT_MIN = 1e-3  # the left edge of the mu(I) panel
 
 
 def fit_mu_i(points):
-    """Least squares of mu(I) = mu1 + (mu2 - mu1) / (I0 / I + 1): (mu1, mu2, I0, rms)."""
+    """Least squares of mu(I) = mu1 + (mu2 - mu1) / (I0 / I + 1), I0 bounded to I0_GRID (its log the
+    fitted parameter), started from five I0 across that range, the best kept: (mu1, mu2, I0, rms)."""
+    lo, hi = math.log10(I0_GRID[0]), math.log10(I0_GRID[1])
+
+    def mu(i, p):
+        return p[0] + (p[1] - p[0]) * i / (10 ** p[2] + i)
+
+    i_s, mus = [i for i, _ in points], [m for _, m in points]
     best = None
-    for k in range(401):
-        i0 = I0_GRID[0] * (I0_GRID[1] / I0_GRID[0]) ** (k / 400.0)
-        # mu = mu1 (1 - f) + mu2 f with f = I / (I0 + I): linear in (mu1, mu2)
-        a11 = a12 = a22 = b1 = b2 = 0.0
-        for i, mu in points:
-            f = i / (i0 + i)
-            g = 1 - f
-            a11 += g * g
-            a12 += g * f
-            a22 += f * f
-            b1 += g * mu
-            b2 += f * mu
-        det = a11 * a22 - a12 * a12
-        if abs(det) < 1e-14:
-            continue
-        mu1 = (b1 * a22 - b2 * a12) / det
-        mu2 = (a11 * b2 - a12 * b1) / det
-        rms = math.sqrt(sum((mu - (mu1 + (mu2 - mu1) * i / (i0 + i))) ** 2 for i, mu in points) / len(points))
+    for k in range(5):
+        start = [min(mus), max(mus), lo + (hi - lo) * (k + 0.5) / 5]
+        (mu1, mu2, li0), rms = stats.curve_fit(mu, i_s, mus, start, [-10, -10, lo], [10, 10, hi])
         if best is None or rms < best[3]:
-            best = (mu1, mu2, i0, rms)
+            best = (mu1, mu2, 10 ** li0, rms)
     return best
 
 
@@ -133,13 +127,10 @@ def acceleration(keep, window=1.0):
     path = os.path.join(keep, "series.csv")
     if not os.path.exists(path):
         return None
-    rows = [[float(x) for x in r.split(",")] for r in open(path) if r[0].isdigit()]
-    t_end = rows[-1][0]
-    w = [(r[0], r[2]) for r in rows if r[0] >= t_end - window - 1e-6]
-    mt = sum(t for t, _ in w) / len(w)
-    mv = sum(v for _, v in w) / len(w)
-    slope = sum((t - mt) * (v - mv) for t, v in w) / sum((t - mt) ** 2 for t, _ in w)
-    return w[0][1], w[-1][1], slope
+    c = csv_columns.read_csv(path)
+    t, v = c["t"], c["mean_vx"]
+    w = t >= t[-1] - window - 1e-6
+    return float(v[w][0]), float(v[w][-1]), stats.line_fit(t[w], v[w])[1]
 
 
 def base_friction(o, a, g=9.81):
@@ -201,7 +192,8 @@ def rain_points(done, docs, m):
         prof = os.path.join(docs, n, "profile.csv")
         if not os.path.exists(prof):
             continue
-        rows = [(float(r.split(",")[0]), float(r.split(",")[1])) for r in open(prof) if r[0].isdigit()]
+        c = csv_columns.read_csv(prof)
+        rows = list(zip(c["z"], c["vx"]))
         i = top_layer_inertial_number(rows, o["flow_height"], o["packing_mean"], o["theta_deg"],
                                       done[n]["bed"]["diameter"])
         steady = abs(o["end_dvdt"]) * 2.0 < STEADY_CHANGE * abs(o["end_mean_vx"])
@@ -287,14 +279,13 @@ def report(docs):
                     tans.append((o["inertial_number"], o["mu"]))
                 prof = os.path.join(docs, n, "profile.csv")
                 if os.path.exists(prof):
-                    rows = [r.split(",") for r in open(prof) if r[0].isdigit()]
+                    c = csv_columns.read_csv(prof)
                     h = o["flow_height"]
-                    z = [float(r[0]) / h for r in rows if float(r[0]) < h]
-                    ax[0].plot([float(r[1]) for r in rows if float(r[0]) < h], z, "o", ms=3,
-                               label="%s %g°" % (m, a))
-                    ax[0].plot([float(r[3]) for r in rows if float(r[0]) < h], z, "-", lw=0.8, color="gray")
-                    ax[1].plot([float(r[2]) for r in rows if float(r[0]) < h], z, "o-", ms=3,
-                               label="%s %g°" % (m, a))
+                    below = c["z"] < h
+                    z = c["z"][below] / h
+                    ax[0].plot(c["vx"][below], z, "o", ms=3, label="%s %g°" % (m, a))
+                    ax[0].plot(c["bagnold"][below], z, "-", lw=0.8, color="gray")
+                    ax[1].plot(c["packing"][below], z, "o-", ms=3, label="%s %g°" % (m, a))
         if pts:
             # a flow that came to rest (I below the panel's edge) is drawn at the edge as a "<"
             flowing = [p for p in pts if p[0] >= I_PLOT_MIN]

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Plots of one bucket impact (docs/scenes.md C.1): OUT/impact.png from OUT/impact.csv.
   scripts/plot_impact.py OUT"""
-import csv
+import argparse
 import json
 import os
 import sys
@@ -11,11 +11,15 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
+from csv_columns import read_rows  # noqa: E402
+
 
 def main():
-    out = sys.argv[1]
-    with open(os.path.join(out, "impact.csv")) as f:
-        rows = list(csv.DictReader(x for x in f if not x.startswith("#")))
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("out", metavar="OUT", help="the run's output folder")
+    out = p.parse_args().out
+    rows = read_rows(os.path.join(out, "impact.csv"))
     t = [float(r["t"]) * 1e3 for r in rows]
     s = json.load(open(os.path.join(out, "summary.json")))
     r = s["result"]

@@ -20,6 +20,7 @@ wave.csv (docs/scenes.md B) and writes into RUN_DIR:
                the last bin above the noise floor against time after impact,
                with the front's speed fitted by least squares
 """
+import argparse
 import json
 import os
 import sys
@@ -101,10 +102,9 @@ def plot_front_track(d, caps, bin_width, floor=None):
 
 
 def main():
-    if len(sys.argv) != 2:
-        print(__doc__)
-        return 2
-    d = sys.argv[1]
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("dir", metavar="RUN_DIR", help="the shot's output folder")
+    d = p.parse_args().dir
     summ = json.load(open(os.path.join(d, "summary.json")))
     obs = summ.get("observers", {})
     t_imp = obs.get("t_impact", 0.0) if obs.get("impact") else 0.0

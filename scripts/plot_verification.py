@@ -9,7 +9,7 @@ chung_ooi_test4.png into PNG_DIR. Test 4 is drawn against the measurements of
 Kharaz, Gorham & Salman (2001), read from REFERENCE_CSV (default
 docs/validation/kharaz2001_oblique_impact.csv; its header names the source).
 """
-import csv
+import argparse
 import os
 import sys
 
@@ -19,12 +19,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
+from csv_columns import read_rows as read_csv  # noqa: E402
 from plots import save_figure  # noqa: E402
-
-
-def read_csv(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(line for line in f if not line.startswith("#")))
 
 
 DEFAULT_REFERENCE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "validation",
@@ -177,12 +173,14 @@ def plot_test4(rows, out, ref=None):
     plt.close(fig)
 
 
-def main(argv):
-    if len(argv) not in (3, 4):
-        sys.stderr.write(__doc__)
-        return 2
-    src, dst = argv[1], argv[2]
-    ref = read_reference(argv[3] if len(argv) == 4 else DEFAULT_REFERENCE)
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("src", metavar="CSV_DIR")
+    p.add_argument("dst", metavar="PNG_DIR")
+    p.add_argument("reference", metavar="REFERENCE_CSV", nargs="?", default=DEFAULT_REFERENCE)
+    a = p.parse_args(argv)
+    src, dst = a.src, a.dst
+    ref = read_reference(a.reference)
     os.makedirs(dst, exist_ok=True)
     plot_convergence(read_csv(os.path.join(src, "restitution_convergence.csv")),
                      os.path.join(dst, "restitution_convergence.png"))
@@ -194,4 +192,4 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    sys.exit(main())

@@ -11,6 +11,7 @@ import sys
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
 import campaign_cli  # noqa: E402
 from plots import save_figure  # noqa: E402
+from stats import mean_sd  # noqa: E402
 
 import matplotlib
 
@@ -61,15 +62,6 @@ def runs_of(docs):
     return out
 
 
-def mean_sd(xs):
-    xs = [x for x in xs if x is not None]
-    if not xs:
-        return float("nan"), float("nan")
-    m = sum(xs) / len(xs)
-    sd = math.sqrt(sum((x - m) ** 2 for x in xs) / (len(xs) - 1)) if len(xs) > 1 else float("nan")
-    return m, sd
-
-
 def fmt(m, sd, digits=3):
     if math.isnan(m):
         return "–"
@@ -103,7 +95,8 @@ def mechanism(d):
     out = {"crossings": len(rs)}
     if rs:
         col = lambda k: [float(r[k]) for r in rs]  # noqa: E731
-        mean = lambda xs: sum(xs) / len(xs)  # noqa: E731
+        def mean(xs):
+            return mean_sd(xs)[0]
         for k in ("v_start", "v", "dv_gas", "dv_contact", "dv_gravity", "since", "ascent", "ascent_dv_gas",
                   "ascent_dv_contact", "ascent_dv_gravity"):
             out[k] = mean(col(k))

@@ -27,6 +27,7 @@ import shlex
 import subprocess
 import sys
 import time
+import argparse
 from argparse import Namespace
 
 import numpy as np
@@ -268,17 +269,19 @@ def report():
 
 
 def main():
-    if len(sys.argv) < 2 or sys.argv[1] not in ("run", "report", "list"):
-        raise SystemExit(__doc__)
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("cmd", choices=("run", "report", "list"))
+    p.add_argument("names", metavar="RUN", nargs="*", help="run: the runs (default: all)")
+    a = p.parse_args()
     bin_dir = os.environ.get("REGOLITH_BIN", os.path.join(ROOT, "build", "devel", "lib", "regolith_twin"))
     os.makedirs(DOCS, exist_ok=True)
-    if sys.argv[1] == "list":
+    if a.cmd == "list":
         done = load_done()
         for n in RUNS:
             print("%-28s %s" % (n, "done" if n in done else "-"))
         return
-    if sys.argv[1] == "run":
-        names = sys.argv[2:] or list(RUNS)
+    if a.cmd == "run":
+        names = a.names or list(RUNS)
         for n in names:
             if n not in RUNS:
                 raise SystemExit("unknown run '%s' (%s)" % (n, " ".join(RUNS)))

@@ -1,6 +1,7 @@
 """Shared by the scene campaigns (plume_campaign.py, bucket_campaign.py, incline_campaign.py):
 their command line, and one run of regolith_sim whose summary is kept under docs/ (a run that
 stops leaves failed.txt there instead: reported, and not retried unless asked)."""
+import argparse
 import json
 import os
 import shutil
@@ -9,14 +10,19 @@ import sys
 import time
 
 
-def command_line(doc):
-    """BIN OUT DOCS CMD [NAME...] -> (bin_dir, out, docs, cmd, names); OUT and DOCS made."""
-    if len(sys.argv) < 5:
-        raise SystemExit(doc)
-    bin_dir, out, docs, cmd = sys.argv[1:5]
-    os.makedirs(out, exist_ok=True)
-    os.makedirs(docs, exist_ok=True)
-    return bin_dir, out, docs, cmd, sys.argv[5:]
+def command_line(doc, argv=None):
+    """BIN OUT DOCS CMD [NAME...] -> (bin_dir, out, docs, cmd, names); OUT and DOCS made. `doc` (the
+    campaign's docstring) is its help."""
+    p = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("bin_dir", metavar="BIN", help="the folder of regolith_sim")
+    p.add_argument("out", metavar="OUT", help="where the runs write (scratch)")
+    p.add_argument("docs", metavar="DOCS", help="where the kept results go")
+    p.add_argument("cmd", metavar="CMD", help="what to do (see above)")
+    p.add_argument("names", metavar="NAME", nargs="*", help="runs (default: all)")
+    a = p.parse_args(argv)
+    os.makedirs(a.out, exist_ok=True)
+    os.makedirs(a.docs, exist_ok=True)
+    return a.bin_dir, a.out, a.docs, a.cmd, a.names
 
 
 def check_names(names, known, what="run"):

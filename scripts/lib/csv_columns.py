@@ -1,24 +1,32 @@
-"""Columns of a CSV file with a header row, for the plot scripts."""
+"""CSV files with a header row (lines starting with '#' are comments), read two ways: as columns
+for plots and fits, as rows for tables (tested in test/scripts/tooling_test.py)."""
+import csv
 import os
 
 import numpy as np
 
 
+def read_rows(path):
+    """The data rows of a CSV file as dicts of strings keyed by the header; [] if the file is absent."""
+    if not os.path.exists(path):
+        return []
+    with open(path, newline="") as f:
+        return list(csv.DictReader(line for line in f if not line.startswith("#")))
+
+
 def read_csv(path):
     """A dict of column arrays (float where every value is a number, else
     strings); None if the file is absent or has no data rows."""
-    if not os.path.exists(path):
-        return None
-    with open(path) as f:
-        header = f.readline().strip().split(",")
-        rows = [line.strip().split(",") for line in f if line.strip()]
-    if not rows or header == [""]:
+    rows = read_rows(path)
+    if not rows:
         return None
     cols = {}
-    for i, k in enumerate(header):
-        vals = [r[i] for r in rows]
+    for k in rows[0]:
+        if k is None or k == "":
+            continue
+        vals = [r[k] for r in rows]
         try:
             cols[k] = np.array([float(v) for v in vals])
-        except ValueError:
+        except (TypeError, ValueError):
             cols[k] = np.array(vals)
-    return cols
+    return cols or None

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Plot a run's series.csv: energies, contacts and the motion of tracked groups.
 usage: plot_series.py RUN_DIR  (writes RUN_DIR/series.png)"""
+import argparse
 import csv
-import sys
 
 import matplotlib
 
@@ -11,7 +11,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 
 def main():
-    run = sys.argv[1]
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("run", metavar="RUN_DIR", help="a run's output folder (with series.csv)")
+    run = p.parse_args().run
     rows = list(csv.DictReader(open(f"{run}/series.csv")))
     if not rows:
         return

@@ -11,6 +11,7 @@ row per shot, mean and SD per speed) and DOCS_DIR/campaign_*.png (collected
 mass, crater depth and radius, grains in the horn against time; ejection
 angle histograms) are written from DOCS_DIR.
 """
+import argparse
 import csv
 import json
 import math
@@ -19,6 +20,7 @@ import re
 import sys
 
 from plots import save_figure
+from stats import mean_sd
 
 RUN = re.compile(r"^c(\d+)_r(\d+)$")
 
@@ -43,15 +45,6 @@ def read_series(path):
     with open(path) as f:
         rows = list(csv.DictReader(f))
     return {k: [float(r[k]) for r in rows] for k in rows[0]} if rows else None
-
-
-def mean_sd(xs):
-    xs = [x for x in xs if x is not None]
-    if not xs:
-        return None, None
-    m = sum(xs) / len(xs)
-    sd = math.sqrt(sum((x - m) ** 2 for x in xs) / (len(xs) - 1)) if len(xs) > 1 else None
-    return m, sd
 
 
 def fmt(m, sd, scale=1.0, digits=1):
@@ -90,9 +83,11 @@ def outcome(s):
 
 
 def main():
-    if len(sys.argv) != 3:
-        sys.exit(__doc__)
-    out, docs = sys.argv[1], sys.argv[2]
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("out", metavar="OUT")
+    p.add_argument("docs", metavar="DOCS")
+    a = p.parse_args()
+    out, docs = a.out, a.docs
     runs = {}
     for name in sorted(os.listdir(docs)):
         m = RUN.match(name)
@@ -129,7 +124,7 @@ def main():
         os_ = [r[3] for r in runs.values() if r[0] == v]
 
         def col(key, digits=1):
-            return fmt(*mean_sd([o[key] for o in os_]), digits=digits)
+            return fmt(*mean_sd([o[key] for o in os_], missing=None), digits=digits)
         lines.append(f"| {v} | {len(os_)} | {col('collected_mg')} | {col('in_horn', 0)} | {col('crater_depth_mm')} | "
                      f"{col('crater_radius_mm')} | {col('ejected', 0)} | {col('angle_mean')} | {col('z', 2)} |")
     with open(os.path.join(docs, "campaign.md"), "w") as f:

@@ -9,9 +9,9 @@ partition at the end of the 0.2 ms window, the wave attenuation slopes, the
 Z-model fits, crater, ejecta and collection, and the smallest pair's
 restitution at the shot's resolution.
 """
+import argparse
 import json
 import os
-import sys
 
 
 def load(d):
@@ -31,9 +31,9 @@ def g(x, fmt="{:.3g}"):
 
 
 def main():
-    if len(sys.argv) != 2:
-        sys.exit(__doc__)
-    d = sys.argv[1]
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("dir", metavar="DIR")
+    d = p.parse_args().dir
     runs = load(d)
     print("| run | speed m/s | dt s | repeat (bed rotation, impact shift) | simulated s | steps | grains | wall s |")
     print("|---|---|---|---|---|---|---|---|")

@@ -37,6 +37,8 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
+sys.path.insert(0, HERE)
+from stats import describe  # noqa: E402
 
 # Outcome numbers of summary.json that the plots show, with axis labels.
 PLOTTED = [
@@ -533,12 +535,11 @@ def write_aggregate(out, rows, outcome_keys):
 
 
 def stats(vals):
-    n = len(vals)
-    if n == 0:
-        return None
-    m = sum(vals) / n
-    sd = math.sqrt(sum((v - m) ** 2 for v in vals) / (n - 1)) if n > 1 else 0.0
-    return {"n": n, "mean": m, "sd": sd, "min": min(vals), "max": max(vals)}
+    """describe() of the values, with an SD of 0 for a single one (the tables print it)."""
+    d = describe(vals)
+    if d is not None and d["sd"] is None:
+        d["sd"] = 0.0
+    return d
 
 
 def groups(rows):

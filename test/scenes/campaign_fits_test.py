@@ -38,10 +38,10 @@ class InclineFits(unittest.TestCase):
         mu1, mu2, i0 = 0.38, 0.64, 0.28
         pts = [(i, mu1 + (mu2 - mu1) / (i0 / i + 1)) for i in (0.01, 0.03, 0.1, 0.3, 1.0)]
         a, b, c, rms = incline_campaign.fit_mu_i(pts)
-        self.assertAlmostEqual(a, mu1, delta=2e-3)
-        self.assertAlmostEqual(b, mu2, delta=2e-3)
-        self.assertAlmostEqual(c / i0, 1.0, delta=0.03)  # I0 on a grid of 80 points per decade
-        self.assertLess(rms, 1e-3)
+        self.assertAlmostEqual(a, mu1, delta=1e-8)
+        self.assertAlmostEqual(b, mu2, delta=1e-8)
+        self.assertAlmostEqual(c / i0, 1.0, delta=1e-7)
+        self.assertLess(rms, 1e-9)
         self.assertTrue(incline_campaign.fit_resolved(a, b, c))
 
     def test_flat_noisy_points_are_not_resolved(self):

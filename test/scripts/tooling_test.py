@@ -1,0 +1,100 @@
+#!/usr/bin/python3
+"""The shared tooling of the campaign, report and benchmark scripts (scripts/lib): statistics and fits
+against exact numbers, the CSV readers on files with comments, and the campaigns' command line."""
+import contextlib
+import io
+import math
+import os
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts", "lib"))
+import campaign_cli  # noqa: E402
+import csv_columns  # noqa: E402
+import stats  # noqa: E402
+
+
+class Statistics(unittest.TestCase):
+    def test_describe_drops_missing_values_and_uses_the_sample_sd(self):
+        d = stats.describe([1.0, 2.0, 6.0, None, float("nan")])
+        self.assertEqual(d["n"], 3)
+        self.assertAlmostEqual(d["mean"], 3.0, places=15)
+        self.assertAlmostEqual(d["sd"], math.sqrt(7.0), places=14)  # ((4 + 1 + 9) / 2) ** 0.5
+        self.assertEqual((d["min"], d["max"]), (1.0, 6.0))
+        self.assertIsNone(stats.describe([]))
+        self.assertIsNone(stats.describe([None, float("nan")]))
+        self.assertIsNone(stats.describe([5.0])["sd"])
+
+    def test_mean_sd_marks_what_is_undefined(self):
+        m, sd = stats.mean_sd([])
+        self.assertTrue(math.isnan(m) and math.isnan(sd))
+        self.assertEqual(stats.mean_sd([2.0], missing=None), (2.0, None))
+        self.assertEqual(stats.mean_sd([2.0], missing=float("inf"))[1], float("inf"))
+        self.assertEqual(stats.mean_sd([1.0, 3.0]), (2.0, math.sqrt(2.0)))
+
+    def test_line_and_power_fits_recover_exact_data(self):
+        a, b = stats.line_fit([0, 1, 2, 3], [1, 3, 5, 7])
+        self.assertAlmostEqual(a, 1.0, places=12)
+        self.assertAlmostEqual(b, 2.0, places=12)
+        xs = [0.1, 0.2, 0.5, 1.0, 2.0]
+        amp, alpha = stats.power_fit(xs, [3.0 * x ** 0.6 for x in xs])
+        self.assertAlmostEqual(amp, 3.0, places=10)
+        self.assertAlmostEqual(alpha, 0.6, places=10)
+
+    def test_curve_fit_recovers_an_exponential_and_respects_bounds(self):
+        xs = [0.1 * k for k in range(20)]
+        ys = [2.0 * math.exp(-1.5 * x) for x in xs]
+        p, rms = stats.curve_fit(lambda x, p: p[0] * (np.exp(-p[1] * x)), xs, ys, [1.0, 1.0],
+                                 [0, 0], [10, 10])
+        self.assertAlmostEqual(p[0], 2.0, places=8)
+        self.assertAlmostEqual(p[1], 1.5, places=8)
+        self.assertLess(rms, 1e-10)
+        # a decay fitted to growing data stops at its bound
+        p, _ = stats.curve_fit(lambda x, p: p[0] * (np.exp(-p[1] * x)), xs,
+                               [math.exp(x) for x in xs], [1.0, 1.0], [0, 0], [10, 10])
+        self.assertAlmostEqual(p[1], 0.0, places=12)
+        self.assertGreaterEqual(p[1], 0.0)
+
+
+class CsvFiles(unittest.TestCase):
+    def test_comments_headers_and_columns(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "a.csv")
+            with open(path, "w") as f:
+                f.write("# what the columns are\nt,v,label\n0,1.5,a\n# a comment between rows\n1,2.5,b\n")
+            rows = csv_columns.read_rows(path)
+            self.assertEqual(rows, [{"t": "0", "v": "1.5", "label": "a"}, {"t": "1", "v": "2.5", "label": "b"}])
+            c = csv_columns.read_csv(path)
+            self.assertEqual(list(c["t"]), [0.0, 1.0])
+            self.assertEqual(list(c["v"]), [1.5, 2.5])
+            self.assertEqual(list(c["label"]), ["a", "b"])
+            with open(path, "w") as f:
+                f.write("t,v\n")
+            self.assertEqual(csv_columns.read_rows(path), [])
+            self.assertIsNone(csv_columns.read_csv(path))
+            self.assertEqual(csv_columns.read_rows(os.path.join(d, "absent.csv")), [])
+            self.assertIsNone(csv_columns.read_csv(os.path.join(d, "absent.csv")))
+
+
+class CampaignCommandLine(unittest.TestCase):
+    def test_positionals_and_names(self):
+        with tempfile.TemporaryDirectory() as d:
+            out, docs = os.path.join(d, "out"), os.path.join(d, "docs")
+            got = campaign_cli.command_line("doc", ["bin", out, docs, "run", "a", "b"])
+            self.assertEqual(got, ("bin", out, docs, "run", ["a", "b"]))
+            self.assertTrue(os.path.isdir(out) and os.path.isdir(docs))
+            self.assertEqual(campaign_cli.command_line("doc", ["bin", out, docs, "report"])[4], [])
+
+    def test_too_few_arguments_is_a_usage_error(self):
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err), self.assertRaises(SystemExit) as e:
+            campaign_cli.command_line("doc", ["bin", "out"])
+        self.assertEqual(e.exception.code, 2)
+        self.assertIn("DOCS", err.getvalue())
+
+
+if __name__ == "__main__":
+    unittest.main()

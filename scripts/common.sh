@@ -19,8 +19,8 @@ BUILD_PACKAGES=(g++ make cmake pkg-config catkin libeigen3-dev libyaml-cpp-dev l
   ros-message-generation libgeometry-msgs-dev libsensor-msgs-dev libvisualization-msgs-dev libstd-srvs-dev
   libdiagnostic-msgs-dev libros-rosgraph-msgs-dev libtf2-msgs-dev python3-roslaunch
   python3-std-srvs python3-sensor-msgs python3-rospy python3-rosgraph python3-rosservice python3-roslib)
-# Extra packages for reports (plots).
-REPORT_PACKAGES=(python3-numpy python3-matplotlib)
+# Extra packages for reports (plots, fits).
+REPORT_PACKAGES=(python3-numpy python3-matplotlib python3-scipy)
 
 _apt_updated=0
 need_packages() {

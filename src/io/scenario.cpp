@@ -472,7 +472,7 @@ const GrainGroup* Scenario::group(const std::string& n) const {
 
 namespace {
 
-Scenario interpret_scenario(const YAML::Node& root, const std::string& source) {
+Scenario interpret_scenario(const YAML::Node& root, const std::string& source, const DerivedContact& derived) {
   const Reader rd(source);
   if (!root || !root.IsMap()) throw InputError(source + ": expected a YAML mapping at the top level");
   rd.only(root, "",
@@ -539,12 +539,19 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source) {
   }
   sc.v_ref = rd.number(c, "contact", "v_max", 1.0, 0, 1e5, true);
   const double x_max = rd.number(c, "contact", "x_max", 0.01, 0, 0.5, true) * min_r;
-  if (Reader::get(c, "kn") && !(c["kn"].IsScalar() && c["kn"].Scalar() == "rule"))
+  for (const char* key : {"kn", "dt"})
+    if ((key[0] == 'k' ? derived.kn : derived.dt) > 0 && Reader::get(c, key))
+      rd.fail(std::string("contact.") + key, "set from " + derived.by + " in this scene: remove it here");
+  if (derived.kn > 0)
+    m.kn = derived.kn;
+  else if (Reader::get(c, "kn") && !(c["kn"].IsScalar() && c["kn"].Scalar() == "rule"))
     m.kn = rd.number(c["kn"], "contact.kn", 0, kInf, true);
   else
     m.kn = kn_rule(mean_mass, sc.v_ref, x_max);
   const double n_steps = rd.number(c, "contact", "steps_per_contact", 30, 1, 1e6);
-  if (Reader::get(c, "dt")) {
+  if (derived.dt > 0) {
+    m.dt = derived.dt;
+  } else if (Reader::get(c, "dt")) {
     m.dt = rd.number(c["dt"], "contact.dt", 0, 1, true);
   } else if (m.contact_model == ContactModel::Linear) {
     m.dt = dt_rule(mean_mass, m.kn, n_steps);
@@ -586,7 +593,8 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source) {
   rd.only(sh, "schedule", {"enabled", "speed", "margin", "floor", "after", "check_every"});
   ScheduleParams& q = m.schedule;
   q.enabled = rd.boolean(sh, "schedule", "enabled", false);
-  q.speed = rd.number(sh, "schedule", "speed", sc.v_ref, 0, 1e5, true);
+  q.speed = rd.number(sh, "schedule", "speed", derived.design_speed > 0 ? derived.design_speed : sc.v_ref, 0, 1e5,
+                      true);
   q.margin = rd.number(sh, "schedule", "margin", q.margin, 1, 100);
   q.floor = rd.number(sh, "schedule", "floor", q.floor, 1e-8, 1);
   q.after = rd.number(sh, "schedule", "after", q.after, 0, kInf);
@@ -765,11 +773,11 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source) {
 
 }  // namespace
 
-Scenario parse_scenario(const YAML::Node& root, const std::string& source) {
+Scenario parse_scenario(const YAML::Node& root, const std::string& source, const DerivedContact& derived) {
   // A key that is not a plain name, a list where a name belongs: yaml-cpp's
   // conversion errors become InputErrors naming the file (and line).
   try {
-    return interpret_scenario(root, source);
+    return interpret_scenario(root, source, derived);
   } catch (const YAML::Exception& e) {
     throw InputError(source + ": " + e.what());
   }

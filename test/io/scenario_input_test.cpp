@@ -17,6 +17,7 @@
 #include <map>
 #include <memory>
 #include <regex>
+#include <array>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -186,6 +187,41 @@ TEST_F(ScenarioInput, UnderResolvedContactIsRefusedUnlessAllowed) {
   expect_refused("coarse_dt.yaml", coarse, {"contact.dt", "steps per contact", "guards.allow_under_resolved"});
   const std::string allowed = write("coarse_dt_allowed.yaml", coarse + "guards: {allow_under_resolved: true}\n");
   EXPECT_NO_THROW(rt::load_scenario(allowed));
+}
+
+TEST_F(ScenarioInput, DerivedStiffnessStepAndDesignSpeedReplaceTheFilesRules) {
+  // A scene kind that derives k_n, dt and the schedule's design speed (the sampler, from its shot speed)
+  // hands them to the reader: the model takes them instead of the k_n rule and the dt rule.
+  rt::DerivedContact d;
+  d.kn = 2.5e6;
+  d.dt = 2e-7;
+  d.design_speed = 42;
+  d.by = "test.speed";
+  const std::string base = replaced(kBase, "kn: rule, ", "");  // k_n by the rule, the rule not named
+  const std::string with_schedule = base + "schedule: {enabled: false}\n";
+  const rt::Scenario plain = rt::parse_scenario_text(with_schedule);
+  const rt::Scenario derived = rt::parse_scenario(YAML::Load(with_schedule), "derived.yaml", d);
+  EXPECT_NE(plain.model.kn, d.kn);
+  EXPECT_EQ(derived.model.kn, d.kn);
+  EXPECT_EQ(derived.model.dt, d.dt);
+  EXPECT_EQ(plain.model.schedule.speed, 1.0);  // contact.v_max
+  EXPECT_EQ(derived.model.schedule.speed, 42.0);
+  // the file's own schedule.speed stays
+  const rt::Scenario own = rt::parse_scenario(
+      YAML::Load(base + "schedule: {enabled: false, speed: 7}\n"), "own.yaml", d);
+  EXPECT_EQ(own.model.schedule.speed, 7.0);
+  // a derived value the file also gives is refused, naming the key and who derives it
+  for (const auto& [from, to, key] : std::vector<std::array<std::string, 3>>{
+           {"kn: rule", "kn: 1.0e6", "contact.kn"}, {"steps_per_contact: 30}", "dt: 1.0e-6}", "contact.dt"}}) {
+    try {
+      rt::parse_scenario(YAML::Load(replaced(base.find(from) != std::string::npos ? base : kBase, from, to)),
+                         "both.yaml", d);
+      ADD_FAILURE() << key << " accepted twice";
+    } catch (const rt::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("test.speed"), std::string::npos) << e.what();
+    }
+  }
 }
 
 namespace {

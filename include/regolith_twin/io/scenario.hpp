@@ -81,8 +81,19 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
 // by key, lists and scalars given here replace the base's.
 YAML::Node load_document(const std::string& path, const std::vector<std::string>& overrides = {});
 
+// What a scene kind derives from its own keys instead of reading it from `contact:` and `schedule:`
+// (the sampler: k_n and dt from its shot speed, and that speed as the stiffness schedule's design
+// speed; docs/model.md §4, §17). 0: read from the file as usual. A derived k_n or dt that the file
+// also gives is refused: the file would say one thing and the run do another.
+struct DerivedContact {
+  double kn = 0;            // N/m
+  double dt = 0;            // s
+  double design_speed = 0;  // m/s: schedule.speed where the file does not give it
+  std::string by;           // who derives them, for the message ("sampler.speed")
+};
+
 // Interpret an already parsed document; `source` names it in error messages.
-Scenario parse_scenario(const YAML::Node& root, const std::string& source);
+Scenario parse_scenario(const YAML::Node& root, const std::string& source, const DerivedContact& derived = {});
 Scenario parse_scenario_text(const std::string& yaml_text, const std::string& source = "<string>");
 
 // Remove the grains flagged in `drop` from the scenario's model and from the

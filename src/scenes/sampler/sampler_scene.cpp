@@ -209,16 +209,16 @@ std::unique_ptr<Scene> SamplerKind::prepare(const YAML::Node& doc, const std::st
   ss->spec = parse_sampler(root["sampler"], file);
   const SamplerSpec& sp = ss->spec;
   root.remove("sampler");
-  // Stiffness and step from the shot speed (docs/model.md §4), before the
-  // scenario is read so that its resolution report is the shot's.
+  // Stiffness and step from the shot speed (docs/model.md §4), given to the
+  // scenario reader so that its resolution report is the shot's; a stiffness
+  // schedule's design speed is the shot's (docs/model.md §17).
   const double ratio = sp.speed / sp.v_ref;
-  if (!root["contact"]) root["contact"] = YAML::Node(YAML::NodeType::Map);
-  root["contact"]["kn"] = sp.kn_ref * ratio * ratio;
-  root["contact"]["dt"] = sp.dt_ref / ratio * sp.dt_factor;
-  // A stiffness schedule's design speed is the shot's (docs/model.md §17).
-  if (const YAML::Node& sch = static_cast<const YAML::Node&>(root)["schedule"]; sch && sch.IsMap() && !sch["speed"])
-    root["schedule"]["speed"] = sp.speed;
-  ss->sc = parse_scenario(root, file);
+  DerivedContact derived;
+  derived.kn = sp.kn_ref * ratio * ratio;
+  derived.dt = sp.dt_ref / ratio * sp.dt_factor;
+  derived.design_speed = sp.speed;
+  derived.by = "sampler.speed (k_n = sampler.kn_ref (v / v_ref)^2, dt = sampler.dt_ref (v_ref / v) dt_factor)";
+  ss->sc = parse_scenario(root, file, derived);
   Scenario& sc = ss->sc;
   Model& m = sc.model;
   for (size_t k = 0; k < m.bodies.size(); ++k)

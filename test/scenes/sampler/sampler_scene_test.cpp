@@ -161,6 +161,16 @@ TEST(SamplerScene, BadInputIsRefused) {
   refused({"sampler.projectile_material=lead"}, "sampler.projectile_material");
   refused({"sampler.second_delay=0"}, "sampler.second_delay");
   refused({"sampler.second_shot=maybe"}, "sampler.second_shot");
+  // k_n and dt follow the shot speed: the file cannot also set them.
+  refused({"contact.kn=1e7"}, "contact.kn");
+  refused({"contact.dt=1e-7"}, "contact.dt");
+}
+
+TEST(SamplerScene, TheScheduleTakesTheShotSpeedUnlessGivenOne) {
+  auto sc = load({"schedule.enabled=false"});
+  EXPECT_DOUBLE_EQ(sc->sc.model.schedule.speed, 50.0);  // not contact.v_max (1 m/s)
+  auto own = load({"schedule.speed=70"});
+  EXPECT_DOUBLE_EQ(own->sc.model.schedule.speed, 70.0);
 }
 
 // --- horn geometry and collected mass -------------------------------------------------------

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Bed packing study (docs/validation.md "Beds"; docs/scenes.md E.1, F).
+"""Bed packing study (docs/validation/beds.md; docs/scenes.md E.1, F).
 
   bed_campaign.py BIN OUT DOCS study [CASE...]   small beds: lattice against random fills, packing
                                                   against the solid fraction of the generation region

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Bucket-impact campaign (docs/scenes.md C.1, docs/validation.md "Bucket impact").
+"""Bucket-impact campaign (docs/scenes.md C.1, docs/validation/bucket.md).
 
   bucket_campaign.py BIN OUT DOCS run [BED...]   every run of each bed (default: the 10 cm beds of both
                                                   10 mm materials), then gb_8 ... gbb_12 and gb_10_5mm on request

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """The figures table (docs/validation/figures.csv) and the reproduction page's table, from the
-committed results (docs/validation.md "Figures table").
+committed results (docs/reproduction.md).
 
   figures.py [--check]     write docs/validation/figures.csv and docs/reproduction.md (--check:
                            compare with the committed files instead, exit 1 if they differ)

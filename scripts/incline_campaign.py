@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Inclined-plane campaign (docs/scenes.md C.2, docs/validation.md "Inclined plane").
+"""Inclined-plane campaign (docs/scenes.md C.2, docs/validation/incline.md).
 
   incline_campaign.py BIN OUT DOCS run [RUN...]   runs (default: all), one seed each
   incline_campaign.py BIN OUT DOCS report         DOCS/report.md and incline.png
@@ -51,7 +51,7 @@ RUNS = {
 # profiles and dV/dt are taken; both are passed to every run of the series). Around the flowing
 # friction of moderate: at 30 deg the bed tilted at once flows and stops, at 33-34 deg it still
 # accelerates after 4 s; the 8 s series holds 30.5-32 deg, where the 4 s runs came closest to steady,
-# twice as long (docs/validation.md "Inclined plane": none of them is steady after 8 s either).
+# twice as long (docs/validation/incline.md: none of them is steady after 8 s either).
 SERIES = {
     "moderate": ("moderate", [30, 31, 32, 33, 34], 4.0, 1.0),
     "gravel": ("gravel", [40, 42], 4.0, 1.0),

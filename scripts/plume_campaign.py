@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Plume-erosion campaign (docs/scenes.md D, docs/validation.md "Plume erosion").
+"""Plume-erosion campaign (docs/scenes.md D, docs/validation/plume.md).
 
   plume_campaign.py BIN OUT DOCS calibrate        bisection on the gas profile's scale (seed 1)
   plume_campaign.py BIN OUT DOCS run [RUN...]     runs (default: all), each seed in turn
@@ -27,7 +27,7 @@ MAT = ["materials.regolith", "materials.floor"]
 # The gas profile's one calibrated scale (docs/scenes.md D): U(h) = u_log ln(1 + h / d) above the
 # anchoring plane, zero at the plane. `calibrate` bisects `steps` times on `key` between `bounds`
 # with `fixed` set. PLUME_PROFILE=linear selects the linear profile of the sensitivity check
-# (docs/validation.md "Plume erosion"); PLUME_SET="key=value ..." adds overrides to every run (its
+# (docs/validation/plume.md); PLUME_SET="key=value ..." adds overrides to every run (its
 # calibrated scale, with DOCS a folder of its own).
 PROFILES = {
     "log": {"what": "U(h) = u_log ln(1 + h/d), U(0) = 0", "key": "gas.u_log", "symbol": "u_log", "unit": "m/s",

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Angle of repose on tall poured heaps (docs/validation.md "Angle of repose").
+"""Angle of repose on tall poured heaps (docs/validation/repose.md).
 
   scripts/repose_tall.py run [RUN...]   runs (default: all, in the order of RUNS), one at a time
   scripts/repose_tall.py report         docs/validation/repose/report.md and heaps.png from the kept results

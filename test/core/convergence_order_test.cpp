@@ -1,5 +1,5 @@
 // Convergence order in the time step of an oblique frictional impact on a
-// wall (docs/validation.md, docs/model.md §7): the rebound velocity and spin
+// wall (docs/validation/contact.md, docs/model.md §7): the rebound velocity and spin
 // against a run at 2,560 steps per contact, averaged over entry phases. With
 // forces that are continuous at contact onset (no dashpots: ε_n = ε_t = 1)
 // the tangential spring and the rotation must keep the integrator's second

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """A run whose outputs outgrow the disk (docs/architecture.md, outputs;
-docs/validation.md, Reliability): the file size limit (RLIMIT_FSIZE, as
+docs/validation/reliability.md): the file size limit (RLIMIT_FSIZE, as
 `ulimit -f`; no privileges needed) stands for a full disk. regolith_sim must
 stop with exit 2 and an error naming the file and the reason (not be killed
 by SIGXFSZ), and leave no corrupt file: the series keeps its header and

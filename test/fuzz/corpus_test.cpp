@@ -1,6 +1,6 @@
 // The fuzzing corpus (test/fuzz/corpus/<target>/: seeds, inputs the fuzzer
 // kept, and every input that once made a reader crash) replayed through the
-// fuzz targets built with the ordinary compiler (docs/validation.md,
+// fuzz targets built with the ordinary compiler (docs/validation/reliability.md,
 // "Fuzzing"): every input is read or refused with an InputError.
 #include <gtest/gtest.h>
 

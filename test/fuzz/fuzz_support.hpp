@@ -1,4 +1,4 @@
-// Shared by the fuzz targets (test/fuzz/*_fuzz.cpp, docs/validation.md
+// Shared by the fuzz targets (test/fuzz/*_fuzz.cpp, docs/validation/reliability.md,
 // "Fuzzing"): a scratch folder per process in which an input's parts are
 // written as files, the readers being file readers, and the split of one
 // input into parts.

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The fits of the laboratory campaigns against exact data (docs/validation.md "Bucket impact",
+"""The fits of the laboratory campaigns against exact data (docs/validation/bucket.md,
 "Inclined plane"): the force law across impact speeds, the layer's acceleration and base friction,
 and mu(I)."""
 import math

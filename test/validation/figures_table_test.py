@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The figures table (docs/validation/figures.csv, docs/validation.md "Figures table") and the
+"""The figures table (docs/validation/figures.csv, docs/reproduction.md) and the
 reproduction page (docs/reproduction.md): they are what the committed results give (regenerated and
 compared), every id is present once, in order, and every
 row is well formed: a number or NA, NA exactly when no run is behind it (n = 0), a standard

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Paired landings on perturbed beds (docs/benchmarks.md, B4): the default
+# Paired landings on perturbed beds (docs/bench/b4_landing.md): the default
 # MASCOT landing with one named setting per run, repeats FIRST..LAST (repeat 0
 # is the bed as prepared, 1.. rotated beds with the aim shifted). A run whose
 # summary is already in docs/bench/b4/ is skipped, so the script resumes; each

@@ -2,7 +2,7 @@
 # The default MASCOT landing up to a fixed time after first contact, once per
 # setting, in rounds (the settings in turn, their order reversed every other
 # round): wall time and the lander's state at the window's end, for the
-# sleeping and active-zone settings side by side (docs/benchmarks.md, B2).
+# sleeping and active-zone settings side by side (docs/bench/b2_sleeping.md).
 #
 #   bench/landing_window.sh OUT_DIR [WINDOW_S] [ROUNDS] [THREADS] [SETTING...]
 set -euo pipefail

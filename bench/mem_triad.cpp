@@ -1,6 +1,6 @@
 // One-core memory bandwidth at a given working set: what one thread can
 // stream through the caches this machine gives it, to compare with the
-// bytes a B1 step moves (docs/benchmarks.md, "Where the 1-thread time goes").
+// bytes a B1 step moves (docs/bench/b1_throughput.md, "Where the 1-thread time goes").
 //
 // Three arrays of doubles fill the working set; a[i] = b[i] + s c[i] is run
 // repeatedly and the best pass counts (3 doubles moved per element, the

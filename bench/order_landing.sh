@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Convergence order in the time step (docs/benchmarks.md, B4): the default
+# Convergence order in the time step (docs/bench/order.md): the default
 # MASCOT landing's first 0.5 s after contact (a deterministic early window)
 # at fixed k_n and halved time steps. Each run's series (every 10 ms) and
 # summary are kept in docs/bench/order/ (skipped when present, so the script

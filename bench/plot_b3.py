@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Sampler shot with the stiffness schedule against the shot with every saving
 off, one bed: horn-segment counts, crater depth and ejected grains over time
-(docs/benchmarks.md, B3). Prints the values at the given times.
+(docs/bench/b3_schedule.md). Prints the values at the given times.
 
     bench/plot_b3.py REF_DIR SCHEDULE_DIR OUT.png [T ...]
 """

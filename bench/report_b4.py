@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""B4/B5 on the landing (docs/benchmarks.md): paired differences of a setting
+"""B4/B5 on the landing (docs/bench/b4_landing.md): paired differences of a setting
 from the reference on the same perturbed beds, from the summaries that
 bench/b4_landing.sh keeps in docs/bench/b4/. Prints a markdown table (mean
 difference, 95 % confidence interval from Student's t, the margin, accepted or

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Convergence order in the time step (docs/benchmarks.md, B4): the lander's
+"""Convergence order in the time step (docs/bench/order.md): the lander's
 state in the first 0.5 s of the default landing at halved time steps, from
 the series bench/order_landing.sh keeps in docs/bench/order/ (all runs on one
 relaxed bed). Prints the error of each step against the finest with the

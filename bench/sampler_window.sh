@@ -2,7 +2,7 @@
 # The default sampler shot (config/sampler_shot.yaml, 300 m/s) up to a fixed
 # time after firing, once per setting, in rounds (the settings in turn, their
 # order reversed every other round): wall time, steps and the shot's outputs
-# at the window's end, for the savings alone and together (docs/benchmarks.md, B3).
+# at the window's end, for the savings alone and together (docs/bench/b3_schedule.md).
 #
 #   bench/sampler_window.sh OUT_DIR [WINDOW_S] [ROUNDS] [THREADS] [SETTING...]
 set -euo pipefail

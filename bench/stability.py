@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Stability sweep (docs/benchmarks.md, "Stability edge"): for each scene, raise
+"""Stability sweep (docs/bench/stability.md): for each scene, raise
 the time step and move k_n away from the scene's values until the run fails,
 and record where it failed, which guard stopped it and with what message; for
 the elastic, frictionless closed box also the energy drift per 10^6 steps.

@@ -742,7 +742,7 @@ void force_pass(const Model& m, State& s) {
     // a thread takes the same partitions and merge blocks every step, and
     // the integrator's static halves nearly coincide with them, so a
     // thread's grains' data stay in its own core's cache (why it matters:
-    // docs/benchmarks.md). No schedule changes any result.
+    // docs/bench/b1_throughput.md). No schedule changes any result.
 #pragma omp for schedule(static)
     for (int p = 0; p < P; ++p) {
       ThreadScratch& sc = s.scratch[p];

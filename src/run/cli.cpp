@@ -30,7 +30,7 @@ void usage(std::FILE* f, const char* tool) {
                "  --threads N     OpenMP threads (default: all cores)\n"
                "  --set k=v       override a key, e.g. --set contact.steps_per_contact=60 or --set landing.angle_deg=60\n"
                "  --profile P     named settings applied before any --set: profiles/P.yaml beside the scene file,\n"
-               "                  or a file path (e.g. --profile preview: faster, less accurate; docs/benchmarks.md B5)\n"
+               "                  or a file path (e.g. --profile preview: faster, less accurate; docs/bench/b4_landing.md)\n"
                "  --cache DIR     where relaxed beds are kept (default $REGOLITH_CACHE or ~/.cache/regolith_twin)\n"
                "  --relaxed-bed F start from this relaxed bed (a checkpoint of the same grains, e.g. a cache file)\n"
                "  --snapshot F    also write the final grains as a compact bed snapshot F (float32)\n"

@@ -31,7 +31,7 @@ from csv_columns import read_csv  # noqa: E402
 
 def save(fig, path):
     """path written whole: a temporary name unique to the process, then renamed
-    (docs/architecture.md, outputs), so a stopped run never leaves part of a plot."""
+    (docs/files.md, outputs), so a stopped run never leaves part of a plot."""
     tmp = f"{path}.tmp.{os.getpid()}"
     fig.savefig(tmp, dpi=100, format="png")
     os.replace(tmp, path)

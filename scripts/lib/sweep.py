@@ -9,7 +9,7 @@ was stopped is re-run with the same command and continues: finished runs
 (summary.json with status ok) are skipped, unfinished or failed ones redone.
 Afterwards (or with --report-only) OUT/aggregate.csv, OUT/*.png and
 OUT/report.md are written from every run in OUT/runs. Files are written to a
-temporary name and renamed (docs/architecture.md, outputs), and a sweep holds
+temporary name and renamed (docs/files.md, outputs), and a sweep holds
 OUT/.regolith_twin.lock while it runs, so a second sweep into it is refused.
 
 With --record DIR every finished run is also kept as one small JSON,
@@ -122,7 +122,7 @@ def write_json(path, value):
 def hold_folder(out):
     """One sweep per output folder: an exclusive lock on OUT/.regolith_twin.lock
     for the sweep's lifetime (it ends with the process, even when killed), as
-    regolith_land takes its own (docs/architecture.md, outputs)."""
+    regolith_land takes its own (docs/files.md, outputs)."""
     os.makedirs(out, exist_ok=True)
     f = open(os.path.join(out, ".regolith_twin.lock"), "a+")
     try:

@@ -129,7 +129,7 @@ bool finite(const Quat& q) { return q.coeffs().allFinite(); }
 
 // Every value a step reads is checked after the checksum: finite numbers,
 // flags 0 or 1, lists sorted as the builders leave them with indices in
-// range (docs/architecture.md, checkpoints). The checksum proves the file is
+// range (docs/files.md, checkpoints). The checksum proves the file is
 // the one written; this proves it holds a state the engine can step.
 void check_state(Reader& r, const Model& m, const State& s) {
   const int n = m.n_grains;
@@ -333,7 +333,7 @@ void write_checkpoint_file(const std::string& path, const std::string& image) {
 
 std::string read_checkpoint_file(const std::string& path) {
   // Read to the end (a pipe or special file has no size to ask for), at most
-  // the checkpoint limit (docs/architecture.md, "Loaded files").
+  // the checkpoint limit (docs/files.md, "Loaded files").
   return read_file_limited(path, kMaxCheckpointBytes, "checkpoint");
 }
 

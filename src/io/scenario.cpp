@@ -809,7 +809,7 @@ YAML::Node merged(const YAML::Node& base, const YAML::Node& over) {
 }
 
 YAML::Node read_document(const std::string& path, int depth) {
-  // Size and nesting are bounded before yaml-cpp sees the text (docs/architecture.md, "Loaded files").
+  // Size and nesting are bounded before yaml-cpp sees the text (docs/files.md, "Loaded files").
   const std::string text = read_file_limited(path, kMaxYamlBytes, "scenario file");
   check_yaml_nesting(path, text);
   YAML::Node root;

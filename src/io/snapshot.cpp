@@ -48,7 +48,7 @@ bool is_snapshot(const std::string& path) {
 }
 
 std::vector<SnapshotGrain> read_snapshot(const std::string& path) {
-  const std::string data = read_file_limited(path, kMaxSnapshotBytes, "bed snapshot");  // docs/architecture.md
+  const std::string data = read_file_limited(path, kMaxSnapshotBytes, "bed snapshot");  // docs/files.md
   auto fail = [&](const std::string& what) { throw InputError(path + ": not a usable bed snapshot: " + what); };
   if (data.size() < 24 || (std::memcmp(data.data(), kMagic, 8) != 0 && std::memcmp(data.data(), kMagic64, 8) != 0))
     fail("wrong file type (no snapshot header)");

@@ -268,7 +268,7 @@ class Loader {
   }
 
   void parse() {
-    // Size and element depth are bounded before urdfdom sees the text (docs/architecture.md, "Loaded files").
+    // Size and element depth are bounded before urdfdom sees the text (docs/files.md, "Loaded files").
     const std::string xml = read_file_limited(path_, kMaxUrdfBytes, "URDF file");
     check_xml_nesting(path_, xml);
     std::string log;
@@ -509,7 +509,7 @@ class Loader {
 }  // namespace
 
 TriangleMesh load_stl(const std::string& path, const Vec3& scale) {
-  const std::string data = read_file_limited(path, kMaxMeshBytes, "STL file");  // docs/architecture.md
+  const std::string data = read_file_limited(path, kMaxMeshBytes, "STL file");  // docs/files.md
   std::vector<RawTriangle> raw;
   // Binary when the size matches the facet count exactly (a binary header may
   // itself begin with "solid"); otherwise ASCII.

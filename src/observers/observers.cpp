@@ -119,7 +119,7 @@ void write_surface(const std::string& path, const Model& m, const State& s, doub
     double& t = top[size_t(iy) * n + ix];
     t = std::max(t, s.pos[i].z() + m.grain_radius[i] - reference);
   }
-  std::ostringstream out;  // written whole at the end (docs/architecture.md, outputs)
+  std::ostringstream out;  // written whole at the end (docs/files.md, outputs)
   out << "x,y,height\n";
   for (int iy = 0; iy < n; ++iy)
     for (int ix = 0; ix < n; ++ix) {
@@ -196,7 +196,7 @@ void Escape::row(const Model& m, const State& s, std::vector<double>& out) const
 
 void Escape::finish(Model& m, State& s) {
   if (log_.empty()) return;
-  std::ostringstream f;  // written whole at the end (docs/architecture.md, outputs)
+  std::ostringstream f;  // written whole at the end (docs/files.md, outputs)
   static const char* names[] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
   f << "t,face,mass,x,y,z,vx,vy,vz\n";
   f.precision(10);

@@ -126,7 +126,7 @@ std::vector<std::string> profile_overrides(const std::string& name, const std::s
   }
   YAML::Node doc;
   try {
-    // Size and nesting bounded as for scenario files (docs/architecture.md, "Loaded files").
+    // Size and nesting bounded as for scenario files (docs/files.md, "Loaded files").
     const std::string text = read_file_limited(path, kMaxYamlBytes, "profile");
     check_yaml_nesting(path, text);
     doc = YAML::Load(text);
@@ -152,7 +152,7 @@ int run_cli(int argc, char** argv, const char* tool) {
   if (const int rc = parse(argc, argv, tool, a); rc >= 0) return rc;
   // A file grown past the size limit (ulimit -f) fails its write with EFBIG
   // and is reported naming it, like a full disk, instead of killing the
-  // tool mid-write (docs/architecture.md, outputs).
+  // tool mid-write (docs/files.md, outputs).
   std::signal(SIGXFSZ, SIG_IGN);
 #ifdef _OPENMP
   if (a.threads > 0) omp_set_num_threads(a.threads);

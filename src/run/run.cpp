@@ -91,7 +91,7 @@ bool Run::settle() {
     if (!opt_.out_dir.empty()) {
       make_dirs(opt_.out_dir);
       // A summary of an earlier run would look finished beside this run's
-      // partial series (docs/architecture.md, outputs): e.g. a landing's
+      // partial series (docs/files.md, outputs): e.g. a landing's
       // bed_relax/ folder, relaxed again after a run was killed.
       const std::string summary = opt_.out_dir + "/summary.json";
       if (std::remove(summary.c_str()) != 0 && errno != ENOENT)

@@ -12,7 +12,7 @@ namespace rt {
 namespace {
 
 void write_final(const std::string& path, const Model& m, const State& s) {
-  std::ostringstream f;  // written whole at the end (docs/architecture.md, outputs)
+  std::ostringstream f;  // written whole at the end (docs/files.md, outputs)
   f << "# id x y z radius vx vy vz  (SI units)\n";
   f.precision(10);
   for (int i = 0; i < m.n_grains; ++i)

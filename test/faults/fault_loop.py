@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """kill -9 at random moments of runs, sweeps and checkpoint saves, and what
-must hold afterwards (docs/architecture.md, outputs; docs/validation/reliability.md):
+must hold afterwards (docs/files.md, outputs; docs/validation/reliability.md):
 
 - every output file is absent, the previous complete version or the new
   complete one: checkpoints, snapshots, surface maps and records byte for

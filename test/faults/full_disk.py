@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A run whose outputs outgrow the disk (docs/architecture.md, outputs;
+"""A run whose outputs outgrow the disk (docs/files.md, outputs;
 docs/validation/reliability.md): the file size limit (RLIMIT_FSIZE, as
 `ulimit -f`; no privileges needed) stands for a full disk. regolith_sim must
 stop with exit 2 and an error naming the file and the reason (not be killed

@@ -1,4 +1,4 @@
-// Size and nesting limits of the file readers (docs/architecture.md, "Loaded
+// Size and nesting limits of the file readers (docs/files.md, "Loaded
 // files"): a file above its reader's size limit, and YAML or XML nested
 // deeper than 64 levels, are refused with an InputError naming the path and
 // the limit before yaml-cpp, urdfdom or a binary reader sees them; the

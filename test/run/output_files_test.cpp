@@ -1,4 +1,4 @@
-// Output files under a full disk (docs/architecture.md, outputs): a file
+// Output files under a full disk (docs/files.md, outputs): a file
 // grown past the size limit (RLIMIT_FSIZE, SIGXFSZ ignored as the tools do)
 // fails its write; whole files keep their previous version and leave no
 // temporary file, the series keeps its complete rows, and each error names

@@ -24,7 +24,7 @@ std::vector<GrainRecord> read_sphere_data(const std::string& path);
 
 // Limits on what a reader accepts before a parser (yaml-cpp, urdfdom, the STL,
 // snapshot and checkpoint readers, Bullet through the meshes) sees a file
-// (docs/architecture.md, "Loaded files"). Generous against the shipped files:
+// (docs/files.md, "Loaded files"). Generous against the shipped files:
 // scenario YAML and URDF files are a few kB, STL meshes 50 kB, bed snapshots
 // 3 MB, checkpoints of the shipped beds ~100 MB.
 constexpr std::size_t kMaxYamlBytes = std::size_t(8) << 20;         // scenarios, profiles, --set values

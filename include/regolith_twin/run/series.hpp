@@ -1,6 +1,6 @@
 // Output files of a run: a CSV time series flushed row by row (so a run that
 // stops early leaves a readable file), a small JSON object writer, and whole
-// files written to a temporary name and renamed (docs/architecture.md, outputs).
+// files written to a temporary name and renamed (docs/files.md, outputs).
 #pragma once
 
 #include <cstdio>
@@ -14,7 +14,7 @@ namespace rt {
 // folder if it does not exist afterwards.
 void make_dirs(const std::string& dir);
 
-// One run per output folder (docs/architecture.md, outputs): creates the
+// One run per output folder (docs/files.md, outputs): creates the
 // folder, takes an exclusive lock on DIR/.regolith_twin.lock for the
 // object's lifetime and removes the summary.json of an earlier run, so a
 // folder never holds a finished-looking summary beside a new run's partial

@@ -79,7 +79,7 @@ std::string HornSegments::progress(const Model& m, const State& s) const {
 }
 
 void HornSegments::write_csv(const std::string& path) const {
-  std::string text = "t,mass,x,y,z,vx,vy,vz\n";  // written whole (docs/architecture.md, outputs)
+  std::string text = "t,mass,x,y,z,vx,vy,vz\n";  // written whole (docs/files.md, outputs)
   char line[192];
   for (const Exit& e : exits_) {
     std::snprintf(line, sizeof line, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", e.t, e.mass, e.pos.x(), e.pos.y(),

@@ -25,7 +25,7 @@ const ImpactClock* need_clock(const ImpactClock* c, const char* who) {
 // is at least t, to rounding of the accumulated time (a millionth of a step).
 bool reached(const Model& m, double after, double t) { return after >= t - 1e-6 * m.dt; }
 
-// A CSV file's text, written whole with write_file at the end (docs/architecture.md, outputs).
+// A CSV file's text, written whole with write_file at the end (docs/files.md, outputs).
 std::ostringstream csv_text() {
   std::ostringstream f;
   f.precision(10);

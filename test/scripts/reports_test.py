@@ -1,0 +1,85 @@
+#!/usr/bin/python3
+"""Every campaign report regenerated from the committed results is the committed report: the bucket,
+inclined-plane, plume, bed and sampler reports (docs/validation/<scene>/), each run on a copy of its
+results folder (nothing under docs/ is written), with its plots drawn."""
+import glob
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+DOCS = os.path.join(ROOT, "docs", "validation")
+PY = "/usr/bin/python3"
+
+
+def run(args, **kw):
+    return subprocess.run([PY] + args, cwd=ROOT, capture_output=True, text=True, timeout=600, **kw)
+
+
+class CampaignReports(unittest.TestCase):
+    def regenerate(self, script, folder, pages):
+        with tempfile.TemporaryDirectory() as tmp:
+            docs = os.path.join(tmp, folder)
+            shutil.copytree(os.path.join(DOCS, folder), docs)
+            for p in pages:
+                os.remove(os.path.join(docs, p))
+            r = run([os.path.join("scripts", script), "/nonexistent", os.path.join(tmp, "out"), docs, "report"])
+            self.assertEqual(r.returncode, 0, r.stderr[-2000:])
+            for p in pages:
+                with open(os.path.join(docs, p)) as a, open(os.path.join(DOCS, folder, p)) as b:
+                    self.assertEqual(a.read(), b.read(), "%s/%s differs from what the committed results give: "
+                                     "run scripts/%s ... report" % (folder, p, script))
+            self.assertTrue(glob.glob(os.path.join(docs, "*.png")), "no plot drawn")
+
+    def test_bucket(self):
+        self.regenerate("bucket_campaign.py", "bucket", ["report.md"])
+
+    def test_incline(self):
+        self.regenerate("incline_campaign.py", "incline", ["report.md"])
+
+    def test_plume(self):
+        self.regenerate("plume_campaign.py", "plume", ["report.md"])
+
+    def test_beds(self):
+        pages = sorted(os.path.basename(p) for p in glob.glob(os.path.join(DOCS, "beds", "*.md")))
+        self.assertTrue(pages)
+        self.regenerate("bed_campaign.py", "beds", pages)
+
+    def test_sampler_runs_and_campaign(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            docs = os.path.join(tmp, "sampler")
+            shutil.copytree(os.path.join(DOCS, "sampler"), docs)
+            r = run([os.path.join("scripts", "lib", "sampler_report.py"), docs])
+            self.assertEqual(r.returncode, 0, r.stderr[-2000:])
+            self.assertIn("| run | speed m/s |", r.stdout)
+            os.remove(os.path.join(docs, "campaign.md"))
+            r = run([os.path.join("scripts", "lib", "sampler_campaign.py"), os.path.join(tmp, "out"), docs])
+            self.assertEqual(r.returncode, 0, r.stderr[-2000:])
+            with open(os.path.join(docs, "campaign.md")) as a, open(os.path.join(DOCS, "sampler", "campaign.md")) as b:
+                self.assertEqual(a.read(), b.read())
+
+
+class Plots(unittest.TestCase):
+    def test_one_run_plots(self):
+        for script, run_dir in (("plot_impact.py", os.path.join(DOCS, "bucket", "gb_10_v0.50")),):
+            with tempfile.TemporaryDirectory() as tmp:
+                d = os.path.join(tmp, "run")
+                shutil.copytree(run_dir, d)
+                r = run([os.path.join("scripts", script), d])
+                self.assertEqual(r.returncode, 0, r.stderr[-2000:])
+                self.assertTrue(glob.glob(os.path.join(d, "*.png")))
+
+    def test_usage_errors_are_argparse_errors(self):
+        for script in ("plot_impact.py", "plot_plume.py", "plot_sampler.py", "figures.py --bogus",
+                       "lib/sampler_report.py", "bucket_campaign.py"):
+            parts = script.split()
+            r = run([os.path.join("scripts", parts[0])] + parts[1:])
+            self.assertEqual(r.returncode, 2, script + ": " + r.stderr[-500:])
+            self.assertIn("usage:", r.stderr, script)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -163,6 +163,9 @@ def bucket():
     return out
 
 
+RAIN_RUNS = {}  # material -> [(angle, flowing, end v, trend)] of its rain runs (for the reproduction page)
+
+
 def incline():
     import incline_campaign as ic
     out = {}
@@ -171,6 +174,7 @@ def incline():
             if os.path.exists(os.path.join(docs, n, "summary.json"))}
     for m in MATERIALS:
         onset, rows = ic.rain_onset(done, m)
+        RAIN_RUNS[m] = rows
         cmd = "scripts/validate_incline run %s" % " ".join(ic.rain_run(m, a) for a in ic.RAIN[m])
         out["incline.onset.%s" % m] = ([onset] if onset is not None else [], cmd)
         n = "onset_%s" % m
@@ -434,8 +438,19 @@ def statements(f):
     for m, lo, hi in (("gravel", 39, 40), ("moderate", 30, 31)):
         fid = "incline.onset.%s" % m
         x = _v(f, fid)
+        text, ok = _fmt(f, fid, unit="°"), None if x is None else lo - 1 <= x <= hi + 1
+        runs = RAIN_RUNS.get(m, [])
+        if x is None and runs:
+            # No onset among the angles run: the deposit flows at none of them (or not at every steeper one).
+            rest = [a for a, fl, _, _ in runs if not fl]
+            flows = [a for a, fl, _, _ in runs if fl]
+            text = "at rest at %s" % ", ".join("%g°" % a for a in rest) + (
+                "; flowing at %s" % ", ".join("%g°" % a for a in flows) if flows else "")
+            if not flows:
+                text = "no flow up to %g° (%s)" % (max(rest), text)
+                ok = False if max(rest) >= hi + 1 else None  # the onset lies above max(rest)
         rows.append(("Inclined plane", "onset, %s: %d–%d° (grains rained onto the tilted plane; ±1°)" % (m, lo, hi),
-                     _fmt(f, fid, unit="°"), None if x is None else lo - 1 <= x <= hi + 1, [fid]))
+                     text, ok, [fid]))
     for m, p in (("gravel", 38.5), ("moderate", 28.0)):
         fid = "repose.%s" % m
         x = _v(f, fid)

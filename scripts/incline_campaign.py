@@ -31,7 +31,7 @@ DOCS_DEFAULT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "d
 RAIN_CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "incline_rain.yaml")
 # The published protocol at fixed angles 1 degree apart around the published onsets (gravel 39-40,
 # moderate 30-31 deg); each run 8 s, judged over its last 2 s (config/incline_rain.yaml).
-RAIN = {"moderate": [29, 30, 31, 32], "gravel": [37, 38, 39, 40, 41]}
+RAIN = {"moderate": [29, 30, 31, 32, 33, 34], "gravel": [37, 38, 39, 40, 41, 42]}
 PUBLISHED_ONSET = {"moderate": (30, 31), "gravel": (39, 40)}
 
 

@@ -96,5 +96,41 @@ class CampaignCommandLine(unittest.TestCase):
         self.assertIn("DOCS", err.getvalue())
 
 
+def load_gate():
+    from importlib.machinery import SourceFileLoader
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts", "gate")
+    return SourceFileLoader("gate", path).load_module()
+
+
+class Gate(unittest.TestCase):
+    def write(self, d, files):
+        for name, text in files.items():
+            os.makedirs(os.path.dirname(os.path.join(d, name)), exist_ok=True)
+            with open(os.path.join(d, name), "w") as f:
+                f.write(text)
+
+    def test_wall_times_plots_and_bed_relax_are_not_differences(self):
+        gate = load_gate()
+        with tempfile.TemporaryDirectory() as t:
+            a, b = os.path.join(t, "a"), os.path.join(t, "b")
+            self.write(a, {"summary.json": '{"run": {"wall_seconds": 1.5, "steps": 10}, "x": [1, 2]}',
+                           "series.csv": "t,v\n0,1\n", "plot.png": "A", "bed_relax/series.csv": "old"})
+            self.write(b, {"summary.json": '{"run": {"wall_seconds": 9.0, "steps": 10}, "x": [1, 2]}',
+                           "series.csv": "t,v\n0,1\n", "plot.png": "B"})
+            self.assertEqual(gate.compare(a, b), [])
+
+    def test_values_bytes_and_missing_files_are_differences(self):
+        gate = load_gate()
+        with tempfile.TemporaryDirectory() as t:
+            a, b = os.path.join(t, "a"), os.path.join(t, "b")
+            self.write(a, {"summary.json": '{"run": {"steps": 10}}', "series.csv": "t,v\n0,1\n",
+                           "ejecta.csv": "x\n"})
+            self.write(b, {"summary.json": '{"run": {"steps": 11}}', "series.csv": "t,v\n0,1.0\n"})
+            got = dict(gate.compare(a, b))
+            self.assertEqual(got["summary.json"], "values differ")
+            self.assertEqual(got["series.csv"], "bytes differ")
+            self.assertTrue(got["ejecta.csv"].startswith("only in"))
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -365,8 +365,9 @@ void Run::progress() {
   else if (obs_left >= 0) eta = "at most " + clock_text(obs_left / std::max(rate, 1e-300));
   char head[256];
   if (bounded)
-    std::snprintf(head, sizeof head, "[%s] stage %zu/%zu '%s'  t = %.4g s of %.4g s", plan_.name.c_str(), k_ + 1,
-                  plan_.stages.size(), plan_.stages[k_].name.c_str(), s_.time, total);
+    std::snprintf(head, sizeof head, "[%s] stage %zu/%zu '%s'  t = %.4g s of %.4g s (%.0f %%)", plan_.name.c_str(),
+                  k_ + 1, plan_.stages.size(), plan_.stages[k_].name.c_str(), s_.time, total,
+                  total > 0 ? 100 * s_.time / total : 100.0);
   else
     std::snprintf(head, sizeof head, "[%s] %s  t = %.4g s", plan_.name.c_str(), plan_.stages[k_].name.c_str(),
                   s_.time);

@@ -2,7 +2,7 @@
 # Paired landings on perturbed beds (docs/bench/b4_landing.md): the default
 # MASCOT landing with one named setting per run, repeats FIRST..LAST (repeat 0
 # is the bed as prepared, 1.. rotated beds with the aim shifted). A run whose
-# summary is already in docs/bench/b4/ is skipped, so the script resumes; each
+# summary is already in results/bench/b4/ is skipped, so the script resumes; each
 # finished run's summary.json is copied there (small, kept in git).
 #
 #   bench/b4_landing.sh SETTING FIRST LAST [THREADS]     e.g. bench/b4_landing.sh ref 1 7
@@ -17,7 +17,7 @@ case $setting in
   preview|coarse2|preview_coarse2|sleep) args=(--profile "$setting") ;;
   *) echo "b4_landing: unknown setting '$setting'" >&2; exit 2 ;;
 esac
-keep=$ROOT/docs/bench/b4
+keep=$ROOT/results/bench/b4
 work=${B4_WORK:-$ROOT/out/b4}
 mkdir -p "$keep" "$work"
 for ((r = first; r <= last; ++r)); do

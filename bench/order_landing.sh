@@ -2,7 +2,7 @@
 # Convergence order in the time step (docs/bench/order.md): the default
 # MASCOT landing's first 0.5 s after contact (a deterministic early window)
 # at fixed k_n and halved time steps. Each run's series (every 10 ms) and
-# summary are kept in docs/bench/order/ (skipped when present, so the script
+# summary are kept in results/bench/order/ (skipped when present, so the script
 # resumes); bench/report_order.py reports the errors and orders.
 #
 #   bench/order_landing.sh [THREADS] [DT ...]     default: 2, 6.25e-6 5e-5 2.5e-5 1.25e-5
@@ -18,7 +18,7 @@ ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BIN=${BIN:-$ROOT/build/devel/lib/regolith_twin}
 threads=${1:-2}; shift || true
 dts=("$@"); [ ${#dts[@]} -gt 0 ] || dts=(6.25e-6 5e-5 2.5e-5 1.25e-5)
-keep=$ROOT/docs/bench/order
+keep=$ROOT/results/bench/order
 work=${ORDER_WORK:-$ROOT/out/order}
 mkdir -p "$keep" "$work"
 common=(--threads "$threads" --quiet --set guards.allow_under_resolved=true --set landing.max_after_contact=0.5)

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """B4/B5 on the landing (docs/bench/b4_landing.md): paired differences of a setting
 from the reference on the same perturbed beds, from the summaries that
-bench/b4_landing.sh keeps in docs/bench/b4/. Prints a markdown table (mean
+bench/b4_landing.sh keeps in results/bench/b4/. Prints a markdown table (mean
 difference, 95 % confidence interval from Student's t, the margin, accepted or
 not) and draws the error against wall time (docs/bench/b4_landing.png).
 
@@ -18,7 +18,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
 from stats import mean_sd  # noqa: E402
 
-KEEP = os.path.join(ROOT, "docs", "bench", "b4")
+KEEP = os.path.join(ROOT, "results", "bench", "b4")
 # output key, label, margin, relative margin?
 OUTPUTS = [("speed_ratio", "speed ratio", 0.05, False),
            ("max_penetration", "max penetration (m)", 0.01, False),

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Convergence order in the time step (docs/bench/order.md): the lander's
 state in the first 0.5 s of the default landing at halved time steps, from
-the series bench/order_landing.sh keeps in docs/bench/order/ (all runs on one
+the series bench/order_landing.sh keeps in results/bench/order/ (all runs on one
 relaxed bed). Prints the error of each step against the finest with the
 observed order log2(e(2h) / e(h)) at several times, and the difference made
 by a 1e-11 m/s change of the impact speed (perturbed.csv, Δt = 2.5e-5 s);
@@ -15,7 +15,7 @@ import math
 import os
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-KEEP = os.path.join(ROOT, "docs", "bench", "order")
+KEEP = os.path.join(ROOT, "results", "bench", "order")
 VEL = ["vx", "vy", "vz"]
 OMEGA = ["wx", "wy", "wz"]
 TIMES = [0.02, 0.03, 0.04, 0.05, 0.1, 0.2, 0.5]

@@ -288,7 +288,7 @@ def report(out):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("out", metavar="OUT", nargs="?", default=os.path.join(ROOT, "docs/bench/stability"))
+    p.add_argument("out", metavar="OUT", nargs="?", default=os.path.join(ROOT, "results/bench/stability"))
     p.add_argument("scenes", metavar="SCENE", nargs="*", help="box, mascot or sampler (default: all three)")
     a = p.parse_args()
     out, scenes = a.out, a.scenes or ["box", "mascot", "sampler"]

@@ -22,6 +22,7 @@ import sys
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 DOCS = os.path.join(ROOT, "docs", "validation")
+RESULTS = os.path.join(ROOT, "results")  # the campaigns' kept runs
 OUT = os.path.join(DOCS, "figures.csv")
 REPRO = os.path.join(ROOT, "docs", "reproduction.md")
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
@@ -113,7 +114,7 @@ def load_json(path):
 
 def beds():
     out = {}
-    root = os.path.join(DOCS, "beds", "prepared")
+    root = os.path.join(RESULTS, "beds", "prepared")
 
     def kept(name):
         f = os.path.join(root, name, "summary.json")
@@ -138,7 +139,7 @@ def beds():
 def bucket():
     import bucket_campaign as bc
     out = {}
-    docs = os.path.join(DOCS, "bucket")
+    docs = os.path.join(RESULTS, "bucket")
     loaded = bc.load(docs)
     tags = {"gb": "gb", "gbb": "gbb", "gb5mm": "gb"}
     for t, h, bed in [(t, h, "%s_%d" % (t, h)) for t in ("gb", "gbb") for h in (8, 10, 12)] + [("gb5mm", 10,
@@ -169,7 +170,7 @@ RAIN_RUNS = {}  # material -> [(angle, flowing, end v, trend)] of its rain runs 
 def incline():
     import incline_campaign as ic
     out = {}
-    docs = os.path.join(DOCS, "incline")
+    docs = os.path.join(RESULTS, "incline")
     done = {n: load_json(os.path.join(docs, n, "summary.json")) for n in ic.RUNS
             if os.path.exists(os.path.join(docs, n, "summary.json"))}
     for m in MATERIALS:
@@ -190,7 +191,7 @@ def incline():
 
 def repose():
     out = {}
-    f = os.path.join(DOCS, "repose", "figures.json")
+    f = os.path.join(RESULTS, "repose", "figures.json")
     got = load_json(f) if os.path.exists(f) else {}
     for m in MATERIALS:
         r = got.get(m)
@@ -203,7 +204,7 @@ PLUME_ALIASES = {"pen4": "base", "ero1": "base", "k8e3": "base", "e0.8_mu0.2": "
 
 def plume():
     out = {}
-    docs = os.path.join(DOCS, "plume")
+    docs = os.path.join(RESULTS, "plume")
     names = ["base", "collisionless", "nondissipative", "pen2", "pen4", "pen6", "ero1", "ero16", "k8e3", "k8e4",
              "k8e5", "k8e6"] + ["e%s_mu%s" % (e, mu) for e in ("0.6", "0.8") for mu in ("0.2", "0.5", "0.8", "1.4")]
     for n in names:
@@ -226,7 +227,7 @@ def plume():
 
 
 # MASCOT landings: the campaign records of runs on the shipped beds (grids listed here; the grids of
-# earlier beds are kept under docs/validation/campaign/lattice_beds/ and not read).
+# earlier beds are kept under results/campaign/lattice_beds/ and not read).
 MASCOT_GRIDS = {"first_look": "scripts/campaign first_look", "d30": "scripts/campaign a b",
                 "depths": "scripts/campaign c", "low_g": "scripts/campaign d"}
 MASCOT_KEYS = {"speed_ratio": "speed_ratio", "travel": "travel_distance", "collision": "collision_duration",
@@ -236,7 +237,7 @@ MASCOT_KEYS = {"speed_ratio": "speed_ratio", "travel": "travel_distance", "colli
 def mascot():
     vals = {}
     for grid, cmd in MASCOT_GRIDS.items():
-        for f in sorted(glob.glob(os.path.join(DOCS, "campaign", grid, "runs", "*.json"))):
+        for f in sorted(glob.glob(os.path.join(RESULTS, "campaign", grid, "runs", "*.json"))):
             r = load_json(f)
             s = r.get("summary") or {}
             if r.get("sweep_run", {}).get("status") != "ok" or s.get("status") != "ok":
@@ -256,10 +257,10 @@ def mascot():
 
 
 def sampler():
-    """Runs on the shipped beds: docs/validation/sampler/shots/<run>/summary.json, <run> = v300_b<k>
+    """Runs on the shipped beds: results/sampler/shots/<run>/summary.json, <run> = v300_b<k>
     (to 0.25 s at the scene's stiffness), v300_1s_b<k> (1 s, stiffness schedule), v50_b<k>, v50_1s_b<k>."""
     out = {}
-    root = os.path.join(DOCS, "sampler", "shots")
+    root = os.path.join(RESULTS, "sampler", "shots")
     cmd = "scripts/validate_sampler shots"
 
     def runs(prefix):

@@ -27,7 +27,7 @@ import csv_columns  # noqa: E402
 import stats  # noqa: E402
 
 CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "incline_moderate.yaml")
-DOCS_DEFAULT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "validation", "incline")
+DOCS_DEFAULT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "results", "incline")
 RAIN_CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "incline_rain.yaml")
 # The published protocol at fixed angles 1 degree apart around the published onsets (gravel 39-40,
 # moderate 30-31 deg); each run 8 s, judged over its last 2 s (config/incline_rain.yaml).

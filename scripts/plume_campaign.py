@@ -3,7 +3,7 @@
 
   plume_campaign.py BIN OUT DOCS calibrate        bisection on the gas profile's scale (seed 1)
   plume_campaign.py BIN OUT DOCS run [RUN...]     runs (default: all), each seed in turn
-  plume_campaign.py BIN OUT DOCS report           docs/validation/plume/report.md + plots
+  plume_campaign.py BIN OUT DOCS report           results/plume/report.md + plots
   plume_campaign.py BIN OUT DOCS mechanism DIR... the mechanism figures of run folders (crossings.csv, ...)
 
 A finished run's summary.json, its N(t) every millisecond, and its

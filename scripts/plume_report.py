@@ -1,5 +1,5 @@
 """Report of the plume-erosion campaign (scripts/plume_campaign.py report):
-docs/validation/plume/report.md, a table of every run's figures (mean and
+results/plume/report.md, a table of every run's figures (mean and
 sample standard deviation over its seeds), and the plots beside it."""
 import csv
 import glob

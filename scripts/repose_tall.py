@@ -2,7 +2,7 @@
 """Angle of repose on tall poured heaps (docs/validation/repose.md).
 
   scripts/repose_tall.py run [RUN...]   runs (default: all, in the order of RUNS), one at a time
-  scripts/repose_tall.py report         docs/validation/repose/report.md and heaps.png from the kept results
+  scripts/repose_tall.py report         results/repose/report.md and heaps.png from the kept results
   scripts/repose_tall.py list           the runs, and which are done
 
 Scenes: config/validation/pour_tall_moderate.yaml and pour_tall_gravel.yaml (a poured fixed-base
@@ -10,7 +10,7 @@ cone at least 15 mean grain diameters tall). A run is one seed of one pour: "nea
 above the base, about 0.1 m above the final apex, as in the files) or "high" (the outlet, plug and
 hopper's grains raised by 0.40 m). Each run is one regolith_sim process on one thread at the lowest
 priority (nice 15); the raw output goes to out/repose/RUN/. A finished run leaves
-docs/validation/repose/RUN/result.json (angle per quadrant, grains on the base, heap height in mean
+results/repose/RUN/result.json (angle per quadrant, grains on the base, heap height in mean
 grain diameters, wall and CPU time, the command) and RUN/profile.png; a run whose result.json exists is
 skipped (REPOSE_RERUN=1 runs it again), so the study resumes on any machine once those files are
 committed. The angle is measured exactly as for the short heaps (scripts/lib/repose_angle.py, cone
@@ -38,7 +38,7 @@ sys.path.insert(0, os.path.join(HERE, "lib"))
 import repose_angle  # noqa: E402
 from plots import save_figure  # noqa: E402
 
-DOCS = os.path.join(ROOT, "docs", "validation", "repose")
+DOCS = os.path.join(ROOT, "results", "repose")
 OUT = os.path.join(ROOT, "out", "repose")
 BASE_TOP = 0.01  # top of the glued base grains (centres at z = 0, radius 0.01 m)
 MEAN_DIAMETER = 0.02

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Every campaign report regenerated from the committed results is the committed report: the bucket,
-inclined-plane, plume, bed and sampler reports (docs/validation/<scene>/), each run on a copy of its
+inclined-plane, plume, bed and sampler reports (results/<scene>/), each run on a copy of its
 results folder (nothing under docs/ is written), with its plots drawn."""
 import glob
 import os
@@ -11,7 +11,7 @@ import tempfile
 import unittest
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
-DOCS = os.path.join(ROOT, "docs", "validation")
+DOCS = os.path.join(ROOT, "results")
 PY = "/usr/bin/python3"
 
 

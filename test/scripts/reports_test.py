@@ -64,7 +64,8 @@ class CampaignReports(unittest.TestCase):
 
 class Plots(unittest.TestCase):
     def test_one_run_plots(self):
-        for script, run_dir in (("plot_impact.py", os.path.join(DOCS, "bucket", "gb_10_v0.50")),):
+        for script, run_dir in (("plot_impact.py", os.path.join(DOCS, "bucket", "gb_10_v0.50")),
+                                ("plot_sampler.py", os.path.join(DOCS, "sampler", "dt1"))):
             with tempfile.TemporaryDirectory() as tmp:
                 d = os.path.join(tmp, "run")
                 shutil.copytree(run_dir, d)

@@ -75,14 +75,24 @@ void wrap_grains(const Model& m, State& s) {
   }
 }
 
-Grid bin_grains(const Model& m, State& s) {
-  const int n = m.n_grains;
-  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-  for (int i = 0; i < n; ++i) {
+}  // namespace
+
+void grain_bounds(const Model& m, const State& s, Vec3& lo, Vec3& hi) {
+  lo = Vec3::Constant(1e300);
+  hi = Vec3::Constant(-1e300);
+  for (int i = 0; i < m.n_grains; ++i) {
     lo = lo.cwiseMin(s.pos[i]);
     hi = hi.cwiseMax(s.pos[i]);
   }
-  if (n == 0) lo = hi = Vec3::Zero();
+  if (m.n_grains == 0) lo = hi = Vec3::Zero();
+}
+
+namespace {
+
+Grid bin_grains(const Model& m, State& s) {
+  const int n = m.n_grains;
+  Vec3 lo, hi;
+  grain_bounds(m, s, lo, hi);
   double cell = 2 * m.max_radius + m.skin;
   if (!(cell > 0)) cell = 1.0;  // no grains: any cell size
   const long max_cells = std::max<long>(4L * n, 64);

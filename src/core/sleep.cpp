@@ -6,6 +6,7 @@
 
 #include "regolith_twin/core/body.hpp"
 #include "regolith_twin/core/forces.hpp"
+#include "regolith_twin/core/neighbours.hpp"
 
 namespace rt {
 namespace {
@@ -59,12 +60,8 @@ void init_sleep(const Model& m, State& s) {
   z.d_mean = mean_diameter(m);
   const SleepThresholds th = sleep_thresholds(m, z.d_mean);
   const int n = m.n_grains;
-  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-  for (int i = 0; i < n; ++i) {
-    lo = lo.cwiseMin(s.pos[i]);
-    hi = hi.cwiseMax(s.pos[i]);
-  }
-  if (n == 0) lo = hi = Vec3::Zero();
+  Vec3 lo, hi;
+  grain_bounds(m, s, lo, hi);
   // One cell of margin around the grains' box (grains that settle or are
   // thrown a little beyond it still sleep); far ejecta lie outside and stay awake.
   z.cell = th.cell;

@@ -40,6 +40,13 @@ void SceneRun::write_summary(const std::string& path, const Model& m, const Stat
   j.write(path);
 }
 
+JsonObject SceneRun::summary_head(const std::string& scenario, const std::string& file, const RunReport& rep) const {
+  JsonObject j;
+  j.str("kind", kind_).str("scenario", scenario).str("file", file).str("status", rep.status);
+  if (!rep.message.empty()) j.str("message", rep.message);
+  return j;
+}
+
 void SceneRun::add_run_and_observers(JsonObject& j, const Model& m, const RunReport& rep, int threads) const {
   JsonObject run;
   run.num("grains", m.n_grains).num("steps", double(rep.steps)).num("sim_time", rep.sim_time);

@@ -23,6 +23,10 @@ void build_body_list(const Model& m, State& s);
 // build; needed again after a checkpoint restores the list).
 void partition_body_list(const Model& m, State& s);
 
+// The box of the grains' centres, lo and hi (both zero without grains); the cell grids of the contact
+// search and of sleeping are laid over it.
+void grain_bounds(const Model& m, const State& s, Vec3& lo, Vec3& hi);
+
 // Recompute the per-entry constants and the fixed work partition of the
 // current lists (done by every build; needed again only after lists are
 // restored from a checkpoint).

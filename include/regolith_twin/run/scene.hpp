@@ -65,6 +65,8 @@ class SceneRun {
   // The "run" block (grains, steps, simulated and wall time, dt, k_n,
   // threads) and the "observers" block (every observer's summary()) of summary.json.
   void add_run_and_observers(JsonObject& j, const Model& m, const RunReport& rep, int threads) const;
+  // The head of a kind's summary.json: kind, scenario, file, status, and the message of a run that stopped.
+  JsonObject summary_head(const std::string& scenario, const std::string& file, const RunReport& rep) const;
 
  private:
   std::string kind_;

@@ -169,9 +169,7 @@ std::unique_ptr<SceneRun> ImpactScene::begin(Run& run) const { return std::make_
 void ImpactRun::write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
                               int threads) const {
   const ImpactScene& sc = scene_;
-  JsonObject j;
-  j.str("kind", "impact").str("scenario", sc.sc.name).str("file", sc.file).str("status", rep.status);
-  if (!rep.message.empty()) j.str("message", rep.message);
+  JsonObject j = summary_head(sc.sc.name, sc.file, rep);
   JsonObject in;
   in.num("speed", sc.spec.speed).num("gap", sc.spec.gap).num("sphere_radius", sc.radius);
   in.num("aim_x", sc.spec.aim.x()).num("aim_y", sc.spec.aim.y());

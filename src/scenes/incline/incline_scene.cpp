@@ -330,9 +330,7 @@ std::unique_ptr<SceneRun> InclineScene::begin(Run& run) const { return std::make
 void InclineRun::write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
                                int threads) const {
   const InclineScene& sc = scene_;
-  JsonObject j;
-  j.str("kind", "incline").str("scenario", sc.sc.name).str("file", sc.file).str("status", rep.status);
-  if (!rep.message.empty()) j.str("message", rep.message);
+  JsonObject j = summary_head(sc.sc.name, sc.file, rep);
   JsonObject bed;
   bed.num("grains", sc.grains).num("base_grains", sc.base_grains).num("diameter", sc.diameter);
   bed.num("base_top", sc.base_top).num("top", sc.top).num("depth_d", (sc.top - sc.base_top) / sc.diameter);

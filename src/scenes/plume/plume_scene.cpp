@@ -88,9 +88,7 @@ void PlumeRun::write_summary(const std::string& path, const Model& m, const Stat
                              int threads) const {
   const PlumeScene& sc = scene_;
   const PlumeSpec& sp = sc.spec;
-  JsonObject j;
-  j.str("kind", "plume").str("scenario", sc.sc.name).str("file", sc.file).str("status", rep.status);
-  if (!rep.message.empty()) j.str("message", rep.message);
+  JsonObject j = summary_head(sc.sc.name, sc.file, rep);
   JsonObject in;
   in.num("penetration_depth_d", sp.penetration_depth).num("erosion_height_d", sp.erosion_height);
   in.num("duration", sp.duration).str("plane_motion", motion_name(sp.plane_motion));

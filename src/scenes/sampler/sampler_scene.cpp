@@ -123,9 +123,7 @@ void SamplerRun::write_summary(const std::string& path, const Model& m, const St
                                int threads) const {
   const SamplerScene& sc = scene_;
   const SamplerSpec& sp = sc.spec;
-  JsonObject j;
-  j.str("kind", "sampler").str("scenario", sc.sc.name).str("file", sc.file).str("status", rep.status);
-  if (!rep.message.empty()) j.str("message", rep.message);
+  JsonObject j = summary_head(sc.sc.name, sc.file, rep);
   JsonObject in;
   in.num("speed", sp.speed).num("tilt_deg", sp.tilt_deg).num("offset", sp.offset).num("duration", sp.duration);
   in.num("projectile_mass", sp.mass).num("projectile_radius", sp.radius).num("repeat", double(sp.repeat));

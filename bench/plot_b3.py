@@ -9,13 +9,12 @@ import argparse
 import os
 import sys
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scripts", "lib"))
 from csv_columns import read_rows  # noqa: E402
+from plots import pyplot  # noqa: E402
+
+plt = pyplot()
 
 
 def series(d):

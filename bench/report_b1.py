@@ -7,7 +7,12 @@ usage: report_b1.py RAW_LINES_FILE PLOT_PNG > table.md
 import argparse
 import re
 import statistics
+import os
+import sys
 from collections import defaultdict
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scripts", "lib"))
+from plots import pyplot  # noqa: E402
 
 
 def parse(path):
@@ -135,9 +140,7 @@ def main():
                        f"{float(r['ke']):.3g} |")
     print("\n".join(out))
 
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 4))
     width = 0.8 / max(len(engines), 1)
     for k, e in enumerate(engines):

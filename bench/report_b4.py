@@ -16,6 +16,7 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
+from plots import pyplot  # noqa: E402
 from stats import mean_sd  # noqa: E402
 
 KEEP = os.path.join(ROOT, "results", "bench", "b4")
@@ -88,9 +89,7 @@ def main():
 def draw(plot, ref_wall):
     if not plot:
         return
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     fig, axs = plt.subplots(1, len(plot), figsize=(4 * len(plot), 3.4))
     for ax, (lab, pts) in zip(axs, plot.items()):
         for st, wall, m, half, margin in pts:

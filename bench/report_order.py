@@ -13,8 +13,11 @@ import csv
 import glob
 import math
 import os
+import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
+from plots import pyplot  # noqa: E402
 KEEP = os.path.join(ROOT, "results", "bench", "order")
 VEL = ["vx", "vy", "vz"]
 OMEGA = ["wx", "wy", "wz"]
@@ -56,9 +59,7 @@ def main():
             cells.append(f"{err(pert[t], runs[2.5e-5][t], VEL):.2g}")
         print(f"| {t:g} | " + " | ".join(cells) + " |")
     try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        plt = pyplot()
     except ImportError:
         return
     fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4))

@@ -15,9 +15,12 @@ import argparse
 import json
 import os
 import subprocess
+import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
+from plots import pyplot  # noqa: E402
 BIN = os.environ.get("BIN", os.path.join(ROOT, "build/devel/lib/regolith_twin"))
 THREADS = os.environ.get("STABILITY_THREADS", "1")
 WORK = os.environ.get("STABILITY_WORK", os.path.join(ROOT, "out/stability"))  # the runs' own outputs
@@ -236,9 +239,7 @@ def report(out):
     with open(os.path.join(out, "stability.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        plt = pyplot()
     except ImportError:
         return
     fig, axes = plt.subplots(1, len(recs), figsize=(4.2 * len(recs), 4), squeeze=False)

@@ -25,6 +25,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib
 import campaign_cli  # noqa: E402
 import csv_columns  # noqa: E402
 import stats  # noqa: E402
+from plots import pyplot  # noqa: E402
 
 CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "incline_moderate.yaml")
 DOCS_DEFAULT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "results", "incline")
@@ -218,9 +219,7 @@ def window_of(name):
 
 
 def report(docs):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     done = {n: json.load(open(os.path.join(docs, n, "summary.json"))) for n in RUNS
             if os.path.exists(os.path.join(docs, n, "summary.json"))}
     lines = ["# Inclined plane: campaign figures", "",

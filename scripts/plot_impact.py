@@ -6,13 +6,12 @@ import json
 import os
 import sys
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
 from csv_columns import read_rows  # noqa: E402
+from plots import pyplot  # noqa: E402
+
+plt = pyplot()
 
 
 def main():

@@ -19,14 +19,13 @@ import os
 import sys
 import warnings
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
 from csv_columns import read_csv  # noqa: E402
+from plots import pyplot  # noqa: E402
+
+plt = pyplot()
 
 
 def save(fig, path):

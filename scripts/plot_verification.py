@@ -13,14 +13,12 @@ import argparse
 import os
 import sys
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
 from csv_columns import read_rows as read_csv  # noqa: E402
-from plots import save_figure  # noqa: E402
+from plots import pyplot, save_figure  # noqa: E402
+
+plt = pyplot()
 
 
 DEFAULT_REFERENCE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "validation",

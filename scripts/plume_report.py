@@ -10,13 +10,11 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
 import campaign_cli  # noqa: E402
-from plots import save_figure  # noqa: E402
+from plots import pyplot, save_figure  # noqa: E402
+
+plt = pyplot()
 from stats import mean_sd  # noqa: E402
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 
 # Published statements (Berger et al. 2013, abstract) a run can be compared with.
 PUBLISHED = {

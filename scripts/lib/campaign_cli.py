@@ -93,7 +93,8 @@ def failure_lines(docs):
 def write_report(docs, lines, fig, axes, png, caption, legend=True, name="report.md"):
     """Grid (and legends) on the axes; the figure saved as DOCS/PNG with its markdown line when there
     is data (lines is not only the header), and DOCS/report.md written. Returns the report's path."""
-    import matplotlib.pyplot as plt
+    from plots import pyplot
+    plt = pyplot()
     for a in axes:
         a.grid(alpha=0.3)
         if legend and a.get_legend_handles_labels()[0]:

@@ -17,12 +17,10 @@ import math
 import os
 import sys
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 import rosbag  # noqa: E402
-from plots import save_figure  # noqa: E402
+from plots import pyplot, save_figure  # noqa: E402
+
+plt = pyplot()
 
 
 def two_panels(series, path, left, right, equal_right=False):

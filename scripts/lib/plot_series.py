@@ -2,19 +2,21 @@
 """Plot a run's series.csv: energies, contacts and the motion of tracked groups.
 usage: plot_series.py RUN_DIR  (writes RUN_DIR/series.png)"""
 import argparse
-import csv
+import os
+import sys
 
-import matplotlib
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from csv_columns import read_rows  # noqa: E402
+from plots import pyplot  # noqa: E402
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+plt = pyplot()
 
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("run", metavar="RUN_DIR", help="a run's output folder (with series.csv)")
     run = p.parse_args().run
-    rows = list(csv.DictReader(open(f"{run}/series.csv")))
+    rows = read_rows(os.path.join(run, "series.csv"))
     if not rows:
         return
     t = [float(r["t"]) for r in rows]

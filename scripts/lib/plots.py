@@ -7,3 +7,11 @@ def save_figure(fig, path, dpi=110):
     fig.tight_layout()
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
+
+
+def pyplot():
+    """matplotlib's pyplot drawing to files only (the Agg backend), for scripts run without a display."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt

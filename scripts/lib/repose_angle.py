@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from plots import save_figure
+from plots import pyplot, save_figure
 
 
 def load(path):
@@ -134,9 +134,7 @@ def main():
 
 
 def plot(a, runs, angles, spread):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     B = a.half_length
     fig, ax = plt.subplots(figsize=(7.5, 3.6))
     first = runs[0]

@@ -19,7 +19,7 @@ import os
 import re
 import sys
 
-from plots import save_figure
+from plots import pyplot, save_figure
 from stats import mean_sd
 
 RUN = re.compile(r"^c(\d+)_r(\d+)$")
@@ -131,9 +131,7 @@ def main():
         f.write("\n".join(lines) + "\n")
 
     try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        plt = pyplot()
     except ImportError:
         print("sampler_campaign: matplotlib missing, no plots", file=sys.stderr)
         return 0

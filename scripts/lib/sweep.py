@@ -38,6 +38,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 sys.path.insert(0, HERE)
+from plots import pyplot  # noqa: E402
 from stats import describe  # noqa: E402
 
 # Outcome numbers of summary.json that the plots show, with axis labels.
@@ -553,9 +554,7 @@ def groups(rows):
 
 
 def plot_metrics(out, rows, spread):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     g = groups(rows)
     if not g:
@@ -709,7 +708,7 @@ def plot_run(run_dir):
     """The plots of plot_landing.py for one run; a plot problem does not lose the run."""
     import contextlib
     try:
-        import matplotlib.pyplot as plt
+        plt = pyplot()
         import plot_landing
         with contextlib.redirect_stdout(open(os.devnull, "w")):
             plot_landing.main([run_dir])

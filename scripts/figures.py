@@ -164,18 +164,26 @@ def bucket():
     return out
 
 
-RAIN_RUNS = {}  # material -> [(angle, flowing, end v, trend)] of its rain runs (for the reproduction page)
+def incline_done():
+    """name -> summary of every incline run kept under results/incline."""
+    import incline_campaign as ic
+    docs = os.path.join(RESULTS, "incline")
+    return {n: load_json(os.path.join(docs, n, "summary.json")) for n in ic.RUNS
+            if os.path.exists(os.path.join(docs, n, "summary.json"))}
+
+
+def rain_runs(material):
+    """[(angle, flowing, end v, trend)] of the material's rain runs (for the reproduction page)."""
+    import incline_campaign as ic
+    return ic.rain_onset(incline_done(), material)[1]
 
 
 def incline():
     import incline_campaign as ic
     out = {}
-    docs = os.path.join(RESULTS, "incline")
-    done = {n: load_json(os.path.join(docs, n, "summary.json")) for n in ic.RUNS
-            if os.path.exists(os.path.join(docs, n, "summary.json"))}
+    done = incline_done()
     for m in MATERIALS:
-        onset, rows = ic.rain_onset(done, m)
-        RAIN_RUNS[m] = rows
+        onset, _ = ic.rain_onset(done, m)
         cmd = "scripts/validate_incline run %s" % " ".join(ic.rain_run(m, a) for a in ic.RAIN[m])
         out["incline.onset.%s" % m] = ([onset] if onset is not None else [], cmd)
         n = "onset_%s" % m
@@ -440,7 +448,7 @@ def statements(f):
         fid = "incline.onset.%s" % m
         x = _v(f, fid)
         text, ok = _fmt(f, fid, unit="°"), None if x is None else lo - 1 <= x <= hi + 1
-        runs = RAIN_RUNS.get(m, [])
+        runs = rain_runs(m)
         if x is None and runs:
             # No onset among the angles run: the deposit flows at none of them (or not at every steeper one).
             rest = [a for a, fl, _, _ in runs if not fl]

@@ -539,9 +539,10 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
   }
   sc.v_ref = rd.number(c, "contact", "v_max", 1.0, 0, 1e5, true);
   const double x_max = rd.number(c, "contact", "x_max", 0.01, 0, 0.5, true) * min_r;
-  for (const char* key : {"kn", "dt"})
-    if ((key[0] == 'k' ? derived.kn : derived.dt) > 0 && Reader::get(c, key))
-      rd.fail(std::string("contact.") + key, "set from " + derived.by + " in this scene: remove it here");
+  if (derived.kn > 0 && Reader::get(c, "kn"))
+    rd.fail("contact.kn", "set from " + derived.by + " in this scene: remove it here");
+  if (derived.dt > 0 && Reader::get(c, "dt"))
+    rd.fail("contact.dt", "set from " + derived.by + " in this scene: remove it here");
   if (derived.kn > 0)
     m.kn = derived.kn;
   else if (Reader::get(c, "kn") && !(c["kn"].IsScalar() && c["kn"].Scalar() == "rule"))

@@ -5,6 +5,7 @@ import contextlib
 import io
 import math
 import os
+import shutil
 import sys
 import tempfile
 import unittest
@@ -130,6 +131,26 @@ class Gate(unittest.TestCase):
             self.assertEqual(got["summary.json"], "values differ")
             self.assertEqual(got["series.csv"], "bytes differ")
             self.assertTrue(got["ejecta.csv"].startswith("only in"))
+
+    @unittest.skipUnless(os.environ.get("REGOLITH_BIN"), "REGOLITH_BIN (the build's binaries) not set")
+    def test_two_builds_must_load_their_own_libraries(self):
+        gate = load_gate()
+        new = os.environ["REGOLITH_BIN"]
+        with self.assertRaises(SystemExit) as e:
+            gate.check_builds(new, new)
+        self.assertIn("load the same libregolith_", str(e.exception.code))
+        with tempfile.TemporaryDirectory() as old:
+            # A copy of the binary alone still loads the build's libraries: refused.
+            shutil.copy(os.path.join(new, "regolith_sim"), old)
+            with self.assertRaises(SystemExit):
+                gate.check_builds(old, new)
+            # With the libraries beside it, it loads its own.
+            lib = os.path.dirname(os.path.realpath(gate.libraries(new)["libregolith_core.so"]))
+            for f in os.listdir(lib):
+                if f.startswith("libregolith_") and f.endswith(".so"):
+                    shutil.copy(os.path.join(lib, f), old)
+            gate.check_builds(old, new)
+            self.assertTrue(all(p.startswith(os.path.realpath(old)) for p in gate.libraries(old).values()))
 
 
 if __name__ == "__main__":

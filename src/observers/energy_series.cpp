@@ -48,6 +48,6 @@ void EnergySeries::row(const Model& m, const State& s, std::vector<double>& row)
   }
 }
 
-void EnergySeries::finish(Model& m, State& s) { final_ = energy(m, s); }
+void EnergySeries::finish(const Model& m, const State& s) { final_ = energy(m, s); }
 
 }  // namespace rt

@@ -33,7 +33,7 @@ BodyContacts body_contacts(const State& s, int b, double bed_top) {
 
 // --- ejecta ---------------------------------------------------------------------
 
-void Ejecta::prepare(Model& m, State& s) {
+void Ejecta::start(const Model& m, const State& s) {
   flag_.assign(m.n_grains, 0);
   above0_.assign(m.n_grains, 0);
   for (int i = 0; i < m.n_grains; ++i) above0_[i] = s.pos[i].z() > height_;  // not counted
@@ -41,7 +41,7 @@ void Ejecta::prepare(Model& m, State& s) {
   volume_ = 0;
 }
 
-bool Ejecta::after_step(Model& m, State& s) {
+bool Ejecta::after_step(const Model& m, const State& s) {
   if (!ticks_crossed(s, every_)) return false;
   for (int i = 0; i < m.n_grains; ++i)
     if (!flag_[i] && !above0_[i] && s.pos[i].z() > height_) {
@@ -64,9 +64,8 @@ void ActiveZone::prepare(Model& m, State& s) {
   if (s.rebuild_requested) s.forces_valid = false;
 }
 
-bool ActiveZone::after_step(Model& m, State& s) {
+void ActiveZone::after_measures(Model& m, State& s) {
   if (ticks_crossed(s, every_)) update(m, s, s.bodies[body_].pos, false);
-  return false;
 }
 
 // Update around horizontal position c; returns true when grains changed state.
@@ -194,7 +193,7 @@ void Escape::row(const Model& m, const State& s, std::vector<double>& out) const
   out.push_back(mass_);
 }
 
-void Escape::finish(Model& m, State& s) {
+void Escape::finish(const Model& m, const State& s) {
   if (log_.empty()) return;
   std::ostringstream f;  // written whole at the end (docs/files.md, outputs)
   static const char* names[] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};

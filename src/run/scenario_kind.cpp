@@ -140,7 +140,7 @@ RunReport run_scenario(Scenario& sc, State& s, const RunOptions& opt_in, int thr
   scene.sc = sc;  // for the summary's settings
   Run run(sc.model, s, RunPlan::of(sc), opt);
   ScenarioRun sr(scene, run);
-  for (Observer* o : sr.observers()) run.add_observer(o);
+  sr.attach(run);
   const RunReport rep = run.run();
   sc.groups = run.groups();
   if (!opt.out_dir.empty()) {

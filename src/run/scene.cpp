@@ -47,6 +47,11 @@ JsonObject SceneRun::summary_head(const std::string& scenario, const std::string
   return j;
 }
 
+void SceneRun::attach(Run& run) {
+  for (Observer* o : observers()) run.add_observer(o);
+  for (Fix* f : fixes()) run.add_fix(f);
+}
+
 void SceneRun::add_run_and_observers(JsonObject& j, const Model& m, const RunReport& rep, int threads) const {
   JsonObject run;
   run.num("grains", m.n_grains).num("steps", double(rep.steps)).num("sim_time", rep.sim_time);
@@ -59,6 +64,7 @@ void SceneRun::add_run_and_observers(JsonObject& j, const Model& m, const RunRep
   j.obj("run", run);
   JsonObject obs;
   for (Observer* o : const_cast<SceneRun*>(this)->observers()) o->summary(obs);
+  for (Fix* f : const_cast<SceneRun*>(this)->fixes()) f->summary(obs);
   j.obj("observers", obs);
 }
 
@@ -153,7 +159,7 @@ RunReport run_scene(const Scene& scene, Model& m, State& s, const SceneRunOption
   ro.stage_snapshots = opt.stage_snapshots;
   Run run(m, s, scene.plan, ro);
   std::unique_ptr<SceneRun> sr = scene.begin(run);
-  for (Observer* o : sr->observers()) run.add_observer(o);
+  sr->attach(run);
   const RunReport rep = run.run();
   if (!opt.out_dir.empty()) {
     sr->write_files(opt.out_dir, m, s, rep);

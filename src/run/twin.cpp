@@ -40,7 +40,7 @@ void Twin::restart_run() {
   ro.progress_every = 0;
   run_ = std::make_unique<Run>(model_, state_, scene_->plan, ro);
   scene_run_ = scene_->begin(*run_);
-  for (Observer* o : scene_run_->observers()) run_->add_observer(o);
+  scene_run_->attach(*run_);
   step0_ = state_.step;
   ended_ = run_->ended();
   if (ended_) run_->finish();

@@ -87,7 +87,7 @@ TEST(Escape, AGrainLeavingTheBoxIsTakenOutAndLogged) {
 // The wall spring of grain 0 after each step, before any removal.
 class WallSpring : public rt::Observer {
  public:
-  bool after_step(rt::Model& m, rt::State& s) override {
+  bool after_step(const rt::Model& m, const rt::State& s) override {
     for (int k = 0; k < s.wall_pairs.size(); ++k)
       if (s.wall_pairs.grain[k] == 0) spring = s.wall_pairs.spring_t[k];
     return false;

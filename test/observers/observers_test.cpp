@@ -55,7 +55,7 @@ TEST(Observers, EjectaCountOnceWithVolumeOnSampledSteps) {
   Line l = line(3, 0.01);
   l.s.pos[2].z() = 0.5;  // above the plane at the start: never counted
   rt::Ejecta e(0.2, 10);
-  e.prepare(l.m, l.s);
+  e.start(l.m, l.s);
   l.s.pos[0].z() = 0.3;
   l.s.step = 5;
   l.s.ticks = 5;  // not a sampled step
@@ -95,7 +95,7 @@ TEST(Observers, ActiveZoneFreezesBeyondTheRadiusAndWakesAsTheBodyComes) {
   Line l = line(6, 0.01);  // grains at x = 0 ... 0.5
   for (int k = 0; k < 6; ++k) l.s.vel[k] = Vec3(0, 0, 0.01 * (k + 1));
   rt::Ejecta ejecta(10.0, 1);
-  ejecta.prepare(l.m, l.s);
+  ejecta.start(l.m, l.s);
   rt::ActiveZone z(0, 0.15, 0.06, 1, &ejecta);  // body at x = 0: grains at 0, 0.1 free
   z.prepare(l.m, l.s);
   EXPECT_FALSE(l.s.forces_valid) << "a frozen model needs its lists and forces again";
@@ -106,10 +106,10 @@ TEST(Observers, ActiveZoneFreezesBeyondTheRadiusAndWakesAsTheBodyComes) {
   l.s.bodies[0].pos.x() = 0.01;  // moved less than 2 cm: no update
   l.s.step = 1;
   l.s.ticks = 1;
-  z.after_step(l.m, l.s);
+  z.after_measures(l.m, l.s);
   EXPECT_EQ(l.m.grain_inv_mass[2], 0);
   l.s.bodies[0].pos.x() = 0.3;  // now grains at 0.2, 0.3, 0.4 are inside; 0 and 0.1 stay woken
-  z.after_step(l.m, l.s);
+  z.after_measures(l.m, l.s);
   for (int k = 0; k < 6; ++k) EXPECT_EQ(l.m.grain_inv_mass[k] == 0, k == 5) << k;
   EXPECT_TRUE(l.s.rebuild_requested);
   z.finish(l.m, l.s);

@@ -1,4 +1,5 @@
-// The one run loop: an observer ends the run after the step it says so;
+// The one run loop: an observer ends the run after the step it says so; a
+// fix acts at its hook points in the order of the step;
 // stages run in order with their durations, hold, gravity ramp and speed
 // criteria; series rows come before the step when due, plus a final row;
 // a blow-up ends run() with its diagnostic, observers finished and the rows
@@ -40,16 +41,62 @@ class Counter : public rt::Observer {
  public:
   explicit Counter(long end_at) : end_at_(end_at) {}
   void start(const rt::Model& m, const rt::State& s) override { started = true; }
-  bool after_step(rt::Model& m, rt::State& s) override { return ++steps == end_at_; }
+  bool after_step(const rt::Model& m, const rt::State& s) override { return ++steps == end_at_; }
   void columns(std::vector<std::string>& out) const override { out.push_back("steps"); }
   void row(const rt::Model& m, const rt::State& s, std::vector<double>& out) const override { out.push_back(steps); }
-  void finish(rt::Model& m, rt::State& s) override { ++finished; }
+  void finish(const rt::Model& m, const rt::State& s) override { ++finished; }
   long steps = 0;
   int finished = 0;
   bool started = false;
 
  private:
   long end_at_;
+};
+
+// Writes what it sees into a shared log: the order of the hooks of a step.
+class Log : public rt::Observer {
+ public:
+  explicit Log(std::vector<std::string>& log) : log_(log) {}
+  void start(const rt::Model& m, const rt::State& s) override { log_.push_back("measure start"); }
+  bool after_step(const rt::Model& m, const rt::State& s) override {
+    log_.push_back("measure");
+    return false;
+  }
+  void columns(std::vector<std::string>& out) const override { out.push_back("measured"); }
+
+ private:
+  std::vector<std::string>& log_;
+};
+
+// A fix that logs every hook and, after every step, puts grain 0 back where it started.
+class PinFirst : public rt::Fix {
+ public:
+  explicit PinFirst(std::vector<std::string>& log) : log_(log) {}
+  void prepare(rt::Model& m, rt::State& s) override {
+    log_.push_back("prepare");
+    p0_ = s.pos[0];
+  }
+  void start(rt::Model& m, rt::State& s) override { log_.push_back("fix start"); }
+  void stage_start(const rt::Stage& st, rt::Model& m, rt::State& s, rt::StageReport& rep) override {
+    log_.push_back("stage " + st.name);
+  }
+  void before_step(const rt::Stage& st, rt::Model& m, rt::State& s) override { log_.push_back("before"); }
+  void after_step(const rt::Stage& st, rt::Model& m, rt::State& s) override {
+    log_.push_back("after");
+    s.pos[0] = p0_;
+    s.vel[0].setZero();
+  }
+  void add_grains(rt::Model& m, rt::State& s) override { log_.push_back("add"); }
+  void after_measures(rt::Model& m, rt::State& s) override { log_.push_back("after measures"); }
+  void end_step(rt::Model& m, rt::State& s, bool added) override { log_.push_back("end"); }
+  bool energy_input() const override { return true; }
+  void finish(rt::Model& m, rt::State& s) override { log_.push_back("finish"); }
+  void columns(std::vector<std::string>& out) const override { out.push_back("fixed"); }
+  void row(const rt::Model& m, const rt::State& s, std::vector<double>& out) const override { out.push_back(1); }
+
+ private:
+  std::vector<std::string>& log_;
+  rt::Vec3 p0_ = rt::Vec3::Zero();
 };
 
 // Series rows every 10 steps into a folder of this process, no progress lines.
@@ -90,6 +137,35 @@ TEST(RunLoop, AnObserverEndsTheRun) {
   EXPECT_FALSE(run.advance()) << "an ended run takes no step";
   // Header, rows before steps 0, 10, 20, and the final row.
   EXPECT_EQ(lines(opt.out_dir + "/series.csv"), 1 + 3 + 1);
+}
+
+TEST(RunLoop, AFixActsAtItsHookPointsInTheOrderOfTheStep) {
+  rt::Scenario sc = rt::parse_scenario_text(kPile);
+  rt::State s = sc.initial;
+  const rt::RunOptions opt = writing("_fix", sc.model.dt);
+  rt::RunPlan plan = rt::RunPlan::of(sc);
+  plan.stages.resize(1);
+  plan.stages[0].duration = 2 * sc.model.dt;  // two steps
+  rt::Run run(sc.model, s, plan, opt);
+  std::vector<std::string> log;
+  Log measure(log);
+  PinFirst fix(log);
+  run.add_observer(&measure);
+  run.add_fix(&fix);
+  const rt::Vec3 p0 = s.pos[0];
+  const rt::RunReport rep = run.run();
+  EXPECT_EQ(rep.steps, 2);
+  EXPECT_EQ(s.pos[0], p0) << "the fix put grain 0 back after every step";
+  EXPECT_NE(s.pos[1], sc.initial.pos[1]) << "the others fell";
+  const std::vector<std::string> step = {"before", "after", "add", "measure", "after measures", "end"};
+  std::vector<std::string> want = {"prepare", "measure start", "fix start", "stage hold"};
+  for (int k = 0; k < 2; ++k) want.insert(want.end(), step.begin(), step.end());
+  want.push_back("finish");
+  EXPECT_EQ(log, want);
+  std::ifstream f(opt.out_dir + "/series.csv");
+  std::string header;
+  std::getline(f, header);
+  EXPECT_EQ(header, "t,measured,fixed") << "the fixes' columns follow the measures'";
 }
 
 TEST(RunLoop, StagesHoldRampAndStopOnCriteria) {

@@ -44,7 +44,7 @@ stages:
 class Crossings : public rt::Observer {
  public:
   explicit Crossings(int bounces) : want_(bounces + 1) {}
-  bool after_step(rt::Model& m, rt::State& s) override {
+  bool after_step(const rt::Model& m, const rt::State& s) override {
     const double x = s.pos[0].x();
     if ((x_ < 0) != (x < 0)) speed.push_back(std::fabs(s.vel[0].x()));
     x_ = x;
@@ -115,18 +115,18 @@ TEST(Schedule, BouncesKeepTheirRestitutionInFewerSteps) {
 namespace {
 
 // Grain 1, parked high, is given 4 m/s straight down at time t_go; the
-// overlap of grain 0 (resting on the floor) just before is recorded.
-class Throw : public rt::Observer {
+// overlap of grain 0 (resting on the floor) just before is recorded. A fix:
+// it acts after the measures, before the stiffness schedule's check.
+class Throw : public rt::Fix {
  public:
   explicit Throw(double t_go) : t_go_(t_go) {}
-  bool after_step(rt::Model& m, rt::State& s) override {
+  void after_measures(rt::Model& m, rt::State& s) override {
     if (!thrown && s.time >= t_go_) {
       thrown = true;
       overlap = m.grain_radius[0] - s.pos[0].z();
       kn_before = m.kn;
       s.vel[1] = rt::Vec3(0, 0, -4.0);
     }
-    return thrown && s.time > t_go_ + 0.2;
   }
   bool thrown = false;
   double overlap = 0, kn_before = 0;
@@ -161,7 +161,10 @@ schedule: {enabled: true, floor: 1.0e-3}
   const double kn_scene = sc.model.kn;
   rt::State s = sc.initial;
   Throw t(0.1);
-  const rt::RunReport rep = run_with(sc, s, t);
+  rt::Run run(sc.model, s, rt::RunPlan::of(sc), quiet());
+  run.add_fix(&t);
+  const rt::RunReport rep = run.run();
+  ASSERT_EQ(rep.status, "ok") << rep.message;
   ASSERT_TRUE(t.thrown);
   const rt::ScheduleState& q = s.schedule;
   EXPECT_EQ(q.min_scale, 1.0e-3);

@@ -122,7 +122,7 @@ SceneRunOutcome run_scene(const Scene& sc, Model& m, State& s) {
   Run run(m, s, sc.plan, ro);
   SceneRunOutcome out;
   out.run = sc.begin(run);
-  for (Observer* o : out.run->observers()) run.add_observer(o);
+  out.run->attach(run);
   out.report = run.run();
   return out;
 }

@@ -1,4 +1,4 @@
-// Active zone: grains farther than a radius (horizontally) from a body's
+// Active zone (a fix, run/fix.hpp): grains farther than a radius (horizontally) from a body's
 // vertical axis stay frozen where the start state left them (infinite mass,
 // at rest); the zone follows the body, checked every `every` steps once it
 // has moved 2 cm, and a grain once woken stays free. Changes the model's
@@ -8,16 +8,17 @@
 #pragma once
 
 #include "regolith_twin/observers/ejecta.hpp"
+#include "regolith_twin/run/fix.hpp"
 
 namespace rt {
 
-class ActiveZone : public Observer {
+class ActiveZone : public Fix {
  public:
   // radius 0: every grain stays free. `ejecta` (may be null) are left out of the edge check.
   ActiveZone(int body, double radius, double ring, int every, const Ejecta* ejecta)
       : body_(body), radius_(radius), ring_(ring), every_(every), ejecta_(ejecta) {}
   void prepare(Model& m, State& s) override;
-  bool after_step(Model& m, State& s) override;
+  void after_measures(Model& m, State& s) override;
   void finish(Model& m, State& s) override;
   void summary(JsonObject& out) const override {
     out.num("active_radius", radius_).num("active_grains", double(active_)).num("active_edge_rms_speed", edge_rms_);

@@ -10,8 +10,8 @@ namespace rt {
 class Ejecta : public Observer {
  public:
   Ejecta(double height, int every) : height_(height), every_(every) {}
-  void prepare(Model& m, State& s) override;
-  bool after_step(Model& m, State& s) override;
+  void start(const Model& m, const State& s) override;
+  bool after_step(const Model& m, const State& s) override;
   void columns(std::vector<std::string>& out) const override { out.push_back("ejected_grains"); }
   void row(const Model& m, const State& s, std::vector<double>& out) const override { out.push_back(double(count_)); }
   void summary(JsonObject& out) const override {

@@ -16,7 +16,7 @@ class EnergySeries : public Observer {
   void start(const Model& m, const State& s) override;
   void columns(std::vector<std::string>& out) const override;
   void row(const Model& m, const State& s, std::vector<double>& out) const override;
-  void finish(Model& m, State& s) override;
+  void finish(const Model& m, const State& s) override;
 
   const Energy& initial() const { return initial_; }
   const Energy& final() const { return final_; }      // at the end (after a blow-up: not set)

@@ -28,7 +28,7 @@ class Escape : public Observer {
   bool leaving(const Model& m, const State& s, std::vector<uint8_t>& drop) override;
   void columns(std::vector<std::string>& out) const override;
   void row(const Model& m, const State& s, std::vector<double>& out) const override;
-  void finish(Model& m, State& s) override;
+  void finish(const Model& m, const State& s) override;
   void summary(JsonObject& out) const override;
 
   const std::vector<Exit>& exits() const { return exits_; }

@@ -13,7 +13,7 @@ class RegionCount : public Observer {
  public:
   RegionCount(std::string name, const Vec3& lo, const Vec3& hi) : name_(std::move(name)), lo_(lo), hi_(hi) {}
   void start(const Model& m, const State& s) override { count(m, s); }
-  bool after_step(Model& m, State& s) override {
+  bool after_step(const Model& m, const State& s) override {
     count(m, s);
     return false;
   }

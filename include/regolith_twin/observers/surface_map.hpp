@@ -18,7 +18,7 @@ class SurfaceMap : public Observer {
  public:
   SurfaceMap(std::string path, double half, double reference, double cell)
       : path_(std::move(path)), half_(half), ref_(reference), cell_(cell) {}
-  void finish(Model& m, State& s) override { write_surface(path_, m, s, half_, ref_, cell_); }
+  void finish(const Model& m, const State& s) override { write_surface(path_, m, s, half_, ref_, cell_); }
 
  private:
   std::string path_;

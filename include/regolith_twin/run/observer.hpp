@@ -1,13 +1,14 @@
-// Observers: the measurements of a run, behind one small interface. The run
-// loop (run.hpp) calls prepare() and start() once before the first step,
-// after_step() after every step, asks each observer for its columns of the
-// time series when a row is due, and calls finish() at the run end; summary()
-// gives its figures for summary.json. An observer reads the state; it may
-// change the model only where that is its purpose (the active zone freezes
-// and wakes grains). Scene kinds compose their runs from these
-// (docs/architecture.md).
+// Measures: what reads a run, behind one small interface (docs/architecture.md,
+// "Measures and fixes"). The run loop (run.hpp) calls start() once before the
+// first step, after_step() after every step (where a measure may end the run),
+// asks each measure for its columns of the time series when a row is due, and
+// calls finish() at the run end; summary() gives its figures for summary.json.
+// A measure sees the model and state read-only; what changes them is a fix
+// (fix.hpp). Measures may ask for grains to be taken out of the run (grains
+// that left the scene). Scene kinds compose their runs from both.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -19,36 +20,29 @@ namespace rt {
 class Observer {
  public:
   virtual ~Observer() = default;
-  // Before the first step, ahead of the forces of the start state: an
-  // observer that changes the model does it here (and clears s.forces_valid
-  // when the forces must be recomputed).
-  virtual void prepare(Model& m, State& s) {}
   // Before the first step, once the forces of the start state are known.
   virtual void start(const Model& m, const State& s) {}
-  // After every step, before after_step(): grains to add to the run now
-  // (rt::add_grain, core/edit.hpp; a second projectile).
-  virtual void add_grains(Model& m, State& s) {}
-  // Grains [first, m.n_grains) were just added by some observer's
-  // add_grains(): observers that keep per-grain data grow it here.
+  // Grains [first, m.n_grains) were just added by a fix (a second
+  // projectile): measures that keep per-grain data grow it here.
   virtual void grains_added(const Model& m, const State& s, int first) {}
   // After every step; true ends the run (a landing that has lifted off and flown).
-  virtual bool after_step(Model& m, State& s) { return false; }
+  virtual bool after_step(const Model& m, const State& s) { return false; }
   // Grains to take out of the run: set drop[i] = 1 (drop has one zero entry
   // per grain) and return true if any. Asked after every step, after after_step().
   virtual bool leaving(const Model& m, const State& s, std::vector<uint8_t>& drop) { return false; }
   // Grains were removed: old_to_new[i] is grain i's new index, or -1.
-  // Observers that keep per-grain data renumber it here.
+  // Measures that keep per-grain data renumber it here.
   virtual void grains_removed(const std::vector<int>& old_to_new) {}
-  // Names of this observer's columns of series.csv, and their values now.
+  // Names of this measure's columns of series.csv, and their values now.
   virtual void columns(std::vector<std::string>& out) const {}
   virtual void row(const Model& m, const State& s, std::vector<double>& out) const {}
   // At the run end (also after a blow-up).
-  virtual void finish(Model& m, State& s) {}
+  virtual void finish(const Model& m, const State& s) {}
   // Its figures for summary.json (after finish).
   virtual void summary(JsonObject& out) const {}
   // Text for the progress line ("" for none).
   virtual std::string progress(const Model& m, const State& s) const { return ""; }
-  // Simulated time left at most, s, when the observer knows it (< 0: it does not).
+  // Simulated time left at most, s, when the measure knows it (< 0: it does not).
   virtual double time_left(const State& s) const { return -1; }
 };
 

@@ -1,17 +1,20 @@
-// The one run loop: stages -> step -> observers -> outputs. Every tool runs
-// through it: regolith_sim and regolith_land, the bed relaxation of a scene,
-// the sweep (through regolith_land) and the ROS node (through rt::Twin, which
-// advances it one step at a time).
+// The one run loop: stages -> step -> measures and fixes -> outputs. Every
+// tool runs through it: regolith_sim and regolith_land, the bed relaxation of
+// a scene, the sweep (through regolith_land) and the ROS node (through
+// rt::Twin, which advances it one step at a time).
 //
 // A run works on a model and a state it does not own, following a plan of
-// stages (a scenario's `stages:`, or one open-ended stage that an observer
-// ends, as a landing's). Per step: the stage's gravity ramp, a series row when
-// one is due, the engine step, the stage's after-step actions (held groups,
-// quick-min, spring release, quench), the observers (any of which may end the
-// run), the stage's end criteria, and a progress line every few wall seconds.
-// Observers may take grains out of the run (grains that left the scene): the
+// stages (a scenario's `stages:`, or one open-ended stage that a measure
+// ends, as a landing's). What reads the run is a measure (observer.hpp: series
+// columns, a summary, an end condition); what acts on it is a fix (fix.hpp,
+// called at named points of the step: before it, after it, when grains join,
+// after the measures, at its end). The run's own fixes carry out the stages
+// (stage_fixes.hpp: trim, stiffness, gravity, damping, held groups) and the
+// stiffness schedule; a scene adds its own (the active zone, a second
+// projectile). advance() reads as the step does: a short table of contents.
+// Measures may take grains out of the run (grains that left the scene): the
 // run removes them after the step, keeping every other contact's springs, and
-// renumbers the groups, held grains and observers' data. A numerical blow-up
+// renumbers the groups and every fix's and measure's data. A numerical blow-up
 // ends run() with status "blow_up" and keeps what was written. See docs/architecture.md.
 #pragma once
 
@@ -21,11 +24,18 @@
 #include <vector>
 
 #include "regolith_twin/core/step.hpp"
+#include "regolith_twin/run/fix.hpp"
 #include "regolith_twin/run/observer.hpp"
 #include "regolith_twin/run/series.hpp"
 #include "regolith_twin/io/scenario.hpp"
 
 namespace rt {
+
+class StageEdits;
+class StageGravity;
+class StageDamping;
+class HeldGroups;
+class StiffnessSchedule;
 
 // The stages of a run and what they refer to (groups, the scene stiffness).
 struct RunPlan {
@@ -91,8 +101,11 @@ class Run {
   Run(const Run&) = delete;
   Run& operator=(const Run&) = delete;
 
-  // Observers are not owned; their order is the order of their series columns.
+  // Measures and fixes are not owned. The measures' order is the order of
+  // their series columns (the fixes' columns follow); fixes act in the order
+  // added, after the run's own.
   void add_observer(Observer* o);
+  void add_fix(Fix* f);
 
   // One step, with the stage transitions before it and the observers after
   // it. Returns false (and steps nothing) once the run has ended. Throws BlowUpError.
@@ -118,52 +131,46 @@ class Run {
   const RunPlan& plan() const { return plan_; }
   int stage_index() const { return int(k_); }
   // Grains held in place by the current stage (one flag per grain).
-  const std::vector<uint8_t>& held() const { return held_; }
+  const std::vector<uint8_t>& held() const;
 
  private:
   bool settle();  // stage transitions up to the next step; false at the end
-  void add_grains();      // grains the observers add, announced to every observer
-  void remove_leaving();  // grains the observers take out, renumbered everywhere
+  void start();   // the first call: fixes prepared, forces primed, measures and fixes started, series opened
+  void add_grains();      // grains the fixes add, announced to every fix and measure
+  bool measure();         // the measures' after_step: true if one ends the run
+  void remove_leaving();  // grains the measures take out, renumbered everywhere
+  bool criteria_met();    // the stage's end criteria, when a check is due
   void begin_stage();
   void end_stage(const char* reason);
   void sample();
   void progress();
   void watch_energy();  // energy-growth guard of passive scenes (docs/model.md §13)
-  // Stiffness schedule (docs/model.md §17): its base values at the run's
-  // start, then a check after every step (grain speeds every check_every
-  // steps, or at once when grains were added).
-  void schedule_start();
-  void schedule_check(bool grains_now);
-  void set_stiffness_scale(double scale, bool account);
 
   Model& m_;
   State& s_;
   RunPlan plan_;
   RunOptions opt_;
   std::vector<Observer*> obs_;
+  std::unique_ptr<StageEdits> edits_;
+  std::unique_ptr<StageGravity> gravity_;
+  std::unique_ptr<StageDamping> damping_;
+  std::unique_ptr<HeldGroups> held_;
+  std::unique_ptr<StiffnessSchedule> schedule_;
+  std::vector<Fix*> fixes_;  // the run's own, then the scene's
   RunReport rep_;
   CsvSeries series_;
   bool started_ = false, in_stage_ = false, ended_ = false, finished_ = false;
   size_t k_ = 0;                      // current stage
-  double t_stage_end_ = 0, next_sample_ = 0, next_check_ = 0, next_quench_ = 0;
-  double t_start_ = 0, t_ramp0_ = 0;
+  double t_stage_end_ = 0, next_sample_ = 0, next_check_ = 0;
+  double t_start_ = 0;
   long step0_ = 0;
   long rebuilds0_ = 0, body_rebuilds0_ = 0;
   double awake0_ = 0;  // SleepState::awake_grain_steps at the start
-  bool sched_on_ = false;
-  double sched_kn0_ = 0, sched_body_kn0_ = 0, sched_dt0_ = 0;  // the scene's, at the run's start
-  double sched_m_min_ = 0;  // smallest grain mass, kg
-  long sched_hold_ = 1;     // steps the target must stay low before k_n is lowered
-  double sched_vfast_ = 0;  // v_fast at the last check, m/s, and what set it (progress line)
-  const char* sched_why_ = "";
-  Vec3 g_from_ = Vec3::Zero();
-  std::vector<uint8_t> held_, drop_;
+  std::vector<uint8_t> drop_;
   std::vector<int> old_to_new_;
-  std::vector<int> held_ids_;
-  std::vector<Vec3> held_pos_;
   StageReport sr_;
   EnergyWatch energy_watch_;
-  bool energy_input_ = false;  // energy was put in since the last check (field, wrench, schedule, held grains)
+  bool energy_input_ = false;  // energy was put in since the last check (field, wrench, a fix)
   std::chrono::steady_clock::time_point t0_, last_progress_;
 };
 

@@ -46,8 +46,12 @@ class SceneRun {
  public:
   explicit SceneRun(std::string kind = "") : kind_(std::move(kind)) {}
   virtual ~SceneRun() = default;
-  // In the order of their series columns.
+  // Its measures, in the order of their series columns, and its fixes, in
+  // the order they act (after the run's own).
   virtual std::vector<Observer*> observers() = 0;
+  virtual std::vector<Fix*> fixes() { return {}; }
+  // Both added to the run.
+  void attach(Run& run);
   // summary.json of the run (status and message from the report). By
   // default: the kind, status, run figures and every observer's summary().
   virtual void write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
@@ -63,7 +67,7 @@ class SceneRun {
 
  protected:
   // The "run" block (grains, steps, simulated and wall time, dt, k_n,
-  // threads) and the "observers" block (every observer's summary()) of summary.json.
+  // threads) and the "observers" block (every measure's and fix's summary()) of summary.json.
   void add_run_and_observers(JsonObject& j, const Model& m, const RunReport& rep, int threads) const;
   // The head of a kind's summary.json: kind, scenario, file, status, and the message of a run that stopped.
   JsonObject summary_head(const std::string& scenario, const std::string& file, const RunReport& rep) const;

@@ -59,7 +59,7 @@ void ImpactTracker::start(const Model& m, const State& s) {
   rows_.push_back({s.time, min_bottom_ - surface_, s.bodies[body_].vel.z(), -g_});
 }
 
-bool ImpactTracker::after_step(Model& m, State& s) {
+bool ImpactTracker::after_step(const Model& m, const State& s) {
   const BodyState& b = s.bodies[body_];
   const double v = b.vel.z(), bottom = b.pos.z() - radius_;
   const double a = b.force.z() / mass_ - g_;  // contact force of the step, and gravity
@@ -92,7 +92,7 @@ bool ImpactTracker::after_step(Model& m, State& s) {
   return t_rest_from_ >= 0 && s.time - t_rest_from_ >= spec_.rest_time;  // at rest: the run ends
 }
 
-void ImpactTracker::finish(Model& m, State& s) {
+void ImpactTracker::finish(const Model& m, const State& s) {
   // m a = -m g + f0 + m v^2 / d1: least squares of a + g = f0 / m + v^2 / d1.
   const size_t n = fit_v_.size();
   if (n >= 2) {

@@ -104,17 +104,37 @@ bool onset_flowing(double v_end, double dvdt_end, double hold, double threshold)
   return v_end > threshold && v_end + dvdt_end * hold > threshold;
 }
 
-// --- the observer -------------------------------------------------------------------
+// --- the fix ------------------------------------------------------------------------
 
-void InclineObserver::tilt(Model& m, State& s, double deg) {
-  theta_deg_ = deg;
+void InclineFix::tilt(Model& m, State& s, double deg) {
+  applied_deg_ = deg;
   const double t = deg * kPi / 180;
   m.gravity = Vec3(g_ * std::sin(t), 0, -g_ * std::cos(t));
   s.forces_valid = false;
 }
 
-void InclineObserver::prepare(Model& m, State& s) {
-  tilt(m, s, sp_.onset ? sp_.start_deg : sp_.angle_deg);
+void InclineFix::prepare(Model& m, State& s) { tilt(m, s, sp_.onset ? sp_.start_deg : sp_.angle_deg); }
+
+void InclineFix::after_step(const Stage&, Model& m, State& s) {
+  if (!sp_.rain) return;
+  // Every free grain that touches the plane is glued where it is (docs/scenes.md C.2).
+  bool glued = false;
+  for (int i = 0; i < m.n_grains; ++i)
+    if (m.grain_inv_mass[i] != 0 && s.pos[i].z() - m.grain_radius[i] < floor_) {
+      hold_grain(m, s, i);
+      glued = true;
+    }
+  if (glued) s.rebuild_requested = true;  // pair constants (m*) and partitions follow
+}
+
+void InclineFix::after_measures(Model& m, State& s) {
+  if (measure_.theta_deg() != applied_deg_) tilt(m, s, measure_.theta_deg());  // the onset protocol's next step
+}
+
+// --- the measure --------------------------------------------------------------------
+
+void InclineObserver::start(const Model& m, const State& s) {
+  theta_deg_ = sp_.onset ? sp_.start_deg : sp_.angle_deg;
   hold_from_ = s.time;
   const int layers = std::max(1, int(std::ceil((top_ - base_) / sp_.layer)) + 2);
   sum_vx_.assign(layers, 0);
@@ -133,7 +153,7 @@ double InclineObserver::mean_vx(const Model& m, const State& s) const {
   return n ? v / n : 0;
 }
 
-bool InclineObserver::after_step(Model& m, State& s) {
+bool InclineObserver::after_step(const Model& m, const State& s) {
   if (sp_.onset) {
     const double held = s.time - hold_from_;
     if (!marked_ && held >= (1 - kTrendWindow) * sp_.hold - 0.5 * m.dt) {
@@ -150,21 +170,10 @@ bool InclineObserver::after_step(Model& m, State& s) {
       return true;  // flowing at the end of its hold, and not dying out: the onset angle
     }
     if (theta_deg_ + sp_.step_deg > sp_.max_deg + 1e-9) return true;
-    tilt(m, s, theta_deg_ + sp_.step_deg);
+    theta_deg_ += sp_.step_deg;  // the next hold, one step steeper (InclineFix tilts gravity)
     hold_from_ = s.time;
     marked_ = false;
     return false;
-  }
-  if (sp_.rain) {
-    // Every free grain that touches the plane is glued where it is (docs/scenes.md C.2).
-    bool glued = false;
-    for (int i = 0; i < m.n_grains; ++i)
-      if (m.grain_inv_mass[i] != 0 && s.pos[i].z() - m.grain_radius[i] < floor_) {
-        hold_grain(m, s, i);
-        ++glued_;
-        glued = true;
-      }
-    if (glued) s.rebuild_requested = true;  // pair constants (m*) and partitions follow
   }
   const long every = std::max(1L, std::lround(0.01 / m.dt));
   if (sp_.rain && sp_.rest_speed > 0 && s.step % every == 0 && at_rest_check(m, s)) return true;
@@ -229,7 +238,11 @@ void InclineObserver::find_layers(const Model& m, const State& s) {
   count_.assign(layers, 0);
 }
 
-void InclineObserver::finish(Model& m, State& s) {
+void InclineObserver::finish(const Model& m, const State& s) {
+  if (sp_.rain) {  // the rain scene starts without glued grains (InclineFix glues them)
+    glued_ = 0;
+    for (int i = 0; i < m.n_grains; ++i) glued_ += m.grain_inv_mass[i] == 0;
+  }
   if (sp_.rain && rested_) {
     // Every free grain at rest for rest_hold s: not flowing; the end state is read over that hold.
     end_vx_ = rest_v_.back();
@@ -323,7 +336,8 @@ void InclineObserver::write_csv(const std::string& dir) const {
 InclineRun::InclineRun(const InclineScene& sc, const Model& m)
     : SceneRun("incline"),
       scene_(sc),
-      obs_(sc.spec, sc.base_top, sc.top, sc.diameter, sc.area, m.gravity.norm(), sc.floor_z) {}
+      obs_(sc.spec, sc.base_top, sc.top, sc.diameter, sc.area, m.gravity.norm(), sc.floor_z),
+      fix_(sc.spec, obs_, m.gravity.norm(), sc.floor_z) {}
 
 std::unique_ptr<SceneRun> InclineScene::begin(Run& run) const { return std::make_unique<InclineRun>(*this, run.model()); }
 

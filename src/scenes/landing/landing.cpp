@@ -360,7 +360,7 @@ void LandingTrackerObserver::start(const Model& m, const State& s) {
   tracker_ = std::make_unique<LandingTracker>(m.bodies[b_], sp_, m.gravity, s.time);
 }
 
-bool LandingTrackerObserver::after_step(Model& m, State& s) {
+bool LandingTrackerObserver::after_step(const Model& m, const State& s) {
   max_overlap_ = std::max(max_overlap_, s.stats.max_overlap_ratio);
   return tracker_->update(s.time, s.bodies[b_], body_contacts(s, b_, bed_top_));
 }
@@ -380,7 +380,7 @@ void LandingTrackerObserver::row(const Model& m, const State& s, std::vector<dou
                          body_lin_energy(bm, bs), body_rot_energy(bm, bs), s.stats.max_overlap_ratio});
 }
 
-void LandingTrackerObserver::finish(Model& m, State& s) {
+void LandingTrackerObserver::finish(const Model& m, const State& s) {
   tracker_->finish(s.time);
   double sum = 0;
   long cnt = 0;

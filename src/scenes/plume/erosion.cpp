@@ -12,7 +12,7 @@
 
 namespace rt {
 
-void ErosionObserver::prepare(Model& m, State& s) {
+void ErosionFix::prepare(Model& m, State& s) {
   const int need = std::max(p_.anchor_slot, p_.erosion_slot) + 1;
   if (int(s.field_values.size()) < need) s.field_values.resize(need, 0.0);
   s.field_values[p_.anchor_slot] = p_.anchor;
@@ -27,7 +27,7 @@ void ErosionObserver::prepare(Model& m, State& s) {
 }
 
 // Collisionless study: hold the grains below the anchoring plane, free those above it.
-void ErosionObserver::hold(Model& m, State& s, bool first) {
+void ErosionFix::hold(Model& m, State& s, bool first) {
   const double a = s.field_values[p_.anchor_slot];
   bool changed = false;
   for (int i = 0; i < m.n_grains; ++i) {
@@ -49,7 +49,7 @@ void ErosionObserver::hold(Model& m, State& s, bool first) {
   }
 }
 
-void ErosionObserver::start(const Model& m, const State& s) {
+void ErosionFix::start(Model& m, State& s) {
   const double e = s.field_values[p_.erosion_slot];
   is_above_.assign(m.n_grains, 0);
   above_now_ = 0;
@@ -78,7 +78,7 @@ void ErosionObserver::start(const Model& m, const State& s) {
   last_ = r;
 }
 
-void ErosionObserver::add_fit_point(double t, int n) {
+void ErosionFix::add_fit_point(double t, int n) {
   const double x = t - t0_, y = n;
   fit_sx_ += x;
   fit_sy_ += y;
@@ -87,7 +87,7 @@ void ErosionObserver::add_fit_point(double t, int n) {
   ++fit_n_;
 }
 
-void ErosionObserver::count(const Model& m, const State& s, int& pairs, int& touching) const {
+void ErosionFix::count(const Model& m, const State& s, int& pairs, int& touching) const {
   pairs = 0;
   touching = 0;
   if (above_now_ == 0 || !m.mobile_contacts || s.pairs.row_start.size() != size_t(m.n_grains) + 1) return;
@@ -108,7 +108,7 @@ void ErosionObserver::count(const Model& m, const State& s, int& pairs, int& tou
   }
 }
 
-bool ErosionObserver::after_step(Model& m, State& s) {
+void ErosionFix::after_measures(Model& m, State& s) {
   double& anchor = s.field_values[p_.anchor_slot];
   double& erosion = s.field_values[p_.erosion_slot];
   int up = 0, down = 0;
@@ -165,16 +165,15 @@ bool ErosionObserver::after_step(Model& m, State& s) {
   max_up_ = std::max(max_up_, r.up);
   last_ = r;
   if (steps_ % std::max(1, p_.sample_every) == 0) rows_.push_back(r);
-  return false;
 }
 
-void ErosionObserver::columns(std::vector<std::string>& out) const {
+void ErosionFix::columns(std::vector<std::string>& out) const {
   for (const char* c : {"above", "anchor_plane", "erosion_plane", "up_per_step", "down_per_step", "pairs_per_grain",
                         "touching_fraction"})
     out.push_back(c);
 }
 
-void ErosionObserver::row(const Model& m, const State& s, std::vector<double>& out) const {
+void ErosionFix::row(const Model& m, const State& s, std::vector<double>& out) const {
   const ErosionRow& r = last_;
   out.push_back(above_now_);
   out.push_back(s.field_values.size() > size_t(p_.anchor_slot) ? s.field_values[p_.anchor_slot] : p_.anchor);
@@ -185,7 +184,7 @@ void ErosionObserver::row(const Model& m, const State& s, std::vector<double>& o
   out.push_back(r.touching_fraction);
 }
 
-void ErosionObserver::finish(Model& m, State& s) {
+void ErosionFix::finish(Model& m, State& s) {
   if (!rows_.empty() && rows_.back().step != last_.step) rows_.push_back(last_);  // the last step's row
   // Erosion rate: one least-squares line through N(t) over the non-depleted phase.
   const double n = double(fit_n_), sx = fit_sx_, sy = fit_sy_, sxx = fit_sxx_, sxy = fit_sxy_;
@@ -203,7 +202,7 @@ void ErosionObserver::finish(Model& m, State& s) {
   }
 }
 
-void ErosionObserver::summary(JsonObject& out) const {
+void ErosionFix::summary(JsonObject& out) const {
   JsonObject o;
   o.num("grains_above", above_now_).num("grains", n_grains_);
   o.num("depleted_at", t_depleted_).num("depleted_fraction", p_.depleted_fraction).num("all_above_at", t_all_);
@@ -215,13 +214,13 @@ void ErosionObserver::summary(JsonObject& out) const {
   out.obj("erosion", o);
 }
 
-std::string ErosionObserver::progress(const Model& m, const State& s) const {
+std::string ErosionFix::progress(const Model& m, const State& s) const {
   char b[120];
   std::snprintf(b, sizeof b, "%d of %d grains above the erosion plane", above_now_, n_grains_);
   return b;
 }
 
-void ErosionObserver::write_csv(const std::string& path) const {
+void ErosionFix::write_csv(const std::string& path) const {
   std::ostringstream f;
   f << "# t (s), step, N above the erosion plane, anchoring and erosion planes (m), upward and downward crossings "
        "per step, contacts among the grains above per grain above, fraction of them in contact (moving averages "

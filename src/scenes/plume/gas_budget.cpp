@@ -80,8 +80,8 @@ void ImpulseObserver::start(const Model& m, const State& s) {
   }
 }
 
-bool ImpulseObserver::after_step(Model& m, State& s) {
-  // The planes as the step used them (the erosion observer moves them after this).
+bool ImpulseObserver::after_step(const Model& m, const State& s) {
+  // The planes as the step used them (the erosion fix moves them after the measures).
   const double anchor = s.field_values[anchor_slot_], erosion = s.field_values[erosion_slot_];
   const double surface = erosion - below_, h = 0.5 * m.dt, gz = m.gravity.z();
   for (int i = 0; i < m.n_grains; ++i) {

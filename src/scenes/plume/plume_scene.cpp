@@ -158,7 +158,7 @@ std::vector<std::pair<std::string, std::string>> PlumeRun::files() const {
 
 std::string PlumeRun::result_line(const Model& m, const State& s, const RunReport& rep) const {
   char b[400];
-  const ErosionObserver& e = erosion_;
+  const ErosionFix& e = erosion_;
   char dep[64] = "not depleted";
   if (e.depleted_at() >= 0) std::snprintf(dep, sizeof dep, "depleted at %.4g s", e.depleted_at());
   std::snprintf(b, sizeof b,

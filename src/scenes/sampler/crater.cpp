@@ -100,7 +100,7 @@ void Crater::start(const Model& m, const State& s) {
   measure(m, s);
 }
 
-bool Crater::after_step(Model& m, State& s) {
+bool Crater::after_step(const Model& m, const State& s) {
   if (ticks_crossed(s, every_)) measure(m, s);
   return false;
 }

@@ -59,7 +59,7 @@ void ImpactClock::start(const Model& m, const State& s) {
   if (touching(m, s)) mark(s);
 }
 
-bool ImpactClock::after_step(Model& m, State& s) {
+bool ImpactClock::after_step(const Model& m, const State& s) {
   if (!hit_ && projectile_ >= 0 && touching(m, s)) mark(s);
   return false;
 }
@@ -133,7 +133,7 @@ void EjectionAngles::start(const Model& m, const State& s) {
   volume_ = 0;
 }
 
-bool EjectionAngles::after_step(Model& m, State& s) {
+bool EjectionAngles::after_step(const Model& m, const State& s) {
   if (!clock_->hit() || !ticks_crossed(s, every_, clock_->impact_ticks())) return false;
   const int p = clock_->projectile();
   const double t = clock_->after(s);
@@ -262,7 +262,7 @@ void EnergyPartition::start(const Model& m, const State& s) {
   samples_.clear();
 }
 
-bool EnergyPartition::after_step(Model& m, State& s) {
+bool EnergyPartition::after_step(const Model& m, const State& s) {
   if (complete_ || !clock_->hit()) return false;
   const double t = clock_->after(s);
   const bool end = reached(m, t, window_);
@@ -334,7 +334,7 @@ void WaveAttenuation::start(const Model& m, const State& s) {
   profiles_.clear();
 }
 
-bool WaveAttenuation::after_step(Model& m, State& s) {
+bool WaveAttenuation::after_step(const Model& m, const State& s) {
   if (!clock_->hit()) return false;
   const double t = clock_->after(s);
   while (profiles_.size() < opt_.times.size() && reached(m, t, opt_.times[profiles_.size()]))
@@ -519,7 +519,7 @@ void ZModelSampler::start(const Model& m, const State& s) {
   samples_.clear();
 }
 
-bool ZModelSampler::after_step(Model& m, State& s) {
+bool ZModelSampler::after_step(const Model& m, const State& s) {
   if (!clock_->hit()) return false;
   const double t = clock_->after(s);
   if (samples_.size() >= times_.size() || !reached(m, t, times_[samples_.size()])) return false;

@@ -49,7 +49,7 @@ TEST(InclineOnset, TheHoldEndTrendSeparatesATransientFromFlow) {
 }
 
 TEST(InclineOnset, AStepThroughAnglesSkipsADyingSurgeAndStopsAtSustainedFlow) {
-  // The observer driven with prescribed grain speeds: at rest at 30 deg, a surge that dies (still above
+  // The measure and the fix that tilts gravity for it, driven with prescribed grain speeds: at rest at 30 deg, a surge that dies (still above
   // the threshold at the end of the hold) at 31 deg, and an accelerating flow at 32 deg. A hold-end speed
   // alone would call 31 deg the onset.
   rt::InclineSpec sp;
@@ -59,6 +59,7 @@ TEST(InclineOnset, AStepThroughAnglesSkipsADyingSurgeAndStopsAtSustainedFlow) {
   sp.hold = 0.1;
   const double d = 0.01, g = 9.81;  // threshold 0.01 sqrt(g d) = 3.1 mm/s
   rt::InclineObserver ob(sp, 0.0, 0.1, d, 0.02, g);
+  rt::InclineFix fix(sp, ob, g, 0.0);
   rt::Model m;
   m.n_grains = 2;
   m.grain_inv_mass = {1.0, 1.0};
@@ -66,8 +67,10 @@ TEST(InclineOnset, AStepThroughAnglesSkipsADyingSurgeAndStopsAtSustainedFlow) {
   rt::State s;
   s.pos.assign(2, rt::Vec3::Zero());
   s.vel.assign(2, rt::Vec3::Zero());
-  ob.prepare(m, s);
+  fix.prepare(m, s);
+  ob.start(m, s);
   EXPECT_DOUBLE_EQ(ob.theta_deg(), 30);
+  EXPECT_NEAR(m.gravity.x(), g * std::sin(30 * kPi / 180), 1e-12);
   double theta = ob.theta_deg(), t0 = 0;
   bool done = false;
   for (int k = 0; k < 1000 && !done; ++k) {
@@ -79,6 +82,7 @@ TEST(InclineOnset, AStepThroughAnglesSkipsADyingSurgeAndStopsAtSustainedFlow) {
     if (theta == 32) v = 0.02 + 0.5 * t;
     for (auto& u : s.vel) u = rt::Vec3(v, 0, 0);
     done = ob.after_step(m, s);
+    fix.after_measures(m, s);
     if (ob.theta_deg() != theta) {
       theta = ob.theta_deg();
       t0 = s.time;
@@ -131,7 +135,7 @@ TEST(InclineScene, AFlowingPeriodicBedWrapsWithoutTrippingTheEnergyGuard) {
   ro.progress_every = 0;
   rt::Run run(m, s, sc->plan, ro);
   auto sr = sc->begin(run);
-  for (rt::Observer* ob : sr->observers()) run.add_observer(ob);
+  sr->attach(run);
   const rt::RunReport rep = run.run();
   ASSERT_EQ(rep.status, "ok") << rep.message;
   int wrapped = 0;  // grains that crossed the downhill boundary (without the input rule, the guard stops at 0.32 s)

@@ -54,10 +54,10 @@ rt::ErosionPlanes planes(rt::PlaneMotion motion) {
   return p;
 }
 
-TEST(ErosionObserver, CountsCrossingsAndMovesThePlanes) {
+TEST(ErosionFix, CountsCrossingsAndMovesThePlanes) {
   for (rt::PlaneMotion motion : {rt::PlaneMotion::Net, rt::PlaneMotion::Upward, rt::PlaneMotion::Fixed}) {
     Four f = four();
-    rt::ErosionObserver e(planes(motion));
+    rt::ErosionFix e(planes(motion));
     e.prepare(f.m, f.s);
     ASSERT_EQ(f.s.field_values.size(), 2u);
     e.start(f.m, f.s);
@@ -66,7 +66,7 @@ TEST(ErosionObserver, CountsCrossingsAndMovesThePlanes) {
     f.s.pos[0].z() = 0.003;
     f.s.pos[1].z() = 0.003;
     f.s.time = 1e-6;
-    e.after_step(f.m, f.s);
+    e.after_measures(f.m, f.s);
     EXPECT_EQ(e.above(), 2);
     const double moved1 = motion == rt::PlaneMotion::Fixed ? 0 : 2 * dz;
     EXPECT_NEAR(f.s.field_values[1], 0.002 - moved1, 1e-15);
@@ -75,7 +75,7 @@ TEST(ErosionObserver, CountsCrossingsAndMovesThePlanes) {
     f.s.pos[0].z() = 0.0005;
     f.s.pos[2].z() = 0.003;
     f.s.time = 2e-6;
-    e.after_step(f.m, f.s);
+    e.after_measures(f.m, f.s);
     EXPECT_EQ(e.above(), 2);
     const double moved2 = motion == rt::PlaneMotion::Net ? 2 * dz : motion == rt::PlaneMotion::Upward ? 3 * dz : 0;
     EXPECT_NEAR(f.s.field_values[1], 0.002 - moved2, 1e-15);
@@ -89,7 +89,7 @@ TEST(ErosionObserver, CountsCrossingsAndMovesThePlanes) {
     // Step 3: every grain above.
     for (int i = 0; i < 4; ++i) f.s.pos[i].z() = 0.01;
     f.s.time = 3e-6;
-    e.after_step(f.m, f.s);
+    e.after_measures(f.m, f.s);
     EXPECT_EQ(e.above(), 4);
     EXPECT_DOUBLE_EQ(e.all_above_at(), 3e-6);
     EXPECT_DOUBLE_EQ(e.depleted_at(), 3e-6);  // 4 >= 0.9 * 4 first here
@@ -100,22 +100,22 @@ TEST(ErosionObserver, CountsCrossingsAndMovesThePlanes) {
   }
 }
 
-TEST(ErosionObserver, CollisionlessHoldsTheBedBelowTheAnchoringPlane) {
+TEST(ErosionFix, CollisionlessHoldsTheBedBelowTheAnchoringPlane) {
   Four f = four();
   rt::ErosionPlanes p = planes(rt::PlaneMotion::Fixed);
   p.anchor = 0.0015;
   p.hold_below_anchor = true;
-  rt::ErosionObserver e(p);
+  rt::ErosionFix e(p);
   e.prepare(f.m, f.s);  // every grain (z = 1 mm) is below: held
   for (int i = 0; i < 4; ++i) EXPECT_EQ(f.m.grain_inv_mass[i], 0) << i;
   EXPECT_FALSE(f.s.forces_valid);
   e.start(f.m, f.s);
   f.s.field_values[0] = 0.0005;  // the plane passes below them: freed
-  e.after_step(f.m, f.s);
+  e.after_measures(f.m, f.s);
   for (int i = 0; i < 4; ++i) EXPECT_GT(f.m.grain_inv_mass[i], 0) << i;
   f.s.pos[3].z() = 0.0001;  // one sinks below it: held again, at rest
   f.s.vel[3] = Vec3(1, 0, -1);
-  e.after_step(f.m, f.s);
+  e.after_measures(f.m, f.s);
   EXPECT_EQ(f.m.grain_inv_mass[3], 0);
   EXPECT_EQ(f.s.vel[3], Vec3::Zero());
   e.finish(f.m, f.s);  // the masses restored

@@ -37,8 +37,8 @@ class ImpactTracker : public Observer {
   ImpactTracker(int body, double radius, double surface, double mean_top, double gravity, const ImpactSpec& spec)
       : body_(body), radius_(radius), surface_(surface), mean_top_(mean_top), g_(gravity), spec_(spec) {}
   void start(const Model& m, const State& s) override;
-  bool after_step(Model& m, State& s) override;
-  void finish(Model& m, State& s) override;
+  bool after_step(const Model& m, const State& s) override;
+  void finish(const Model& m, const State& s) override;
   void columns(std::vector<std::string>& out) const override;
   void row(const Model& m, const State& s, std::vector<double>& out) const override;
   void summary(JsonObject& out) const override;

@@ -74,16 +74,16 @@ class InclineObserver : public Observer {
   InclineObserver(const InclineSpec& sp, double base_top, double bed_top, double diameter, double area,
                   double g, double floor_z = 0)
       : sp_(sp), base_(base_top), top_(bed_top), d_(diameter), area_(area), g_(g), floor_(floor_z) {}
-  void prepare(Model& m, State& s) override;
-  bool after_step(Model& m, State& s) override;
-  void finish(Model& m, State& s) override;
+  void start(const Model& m, const State& s) override;
+  bool after_step(const Model& m, const State& s) override;
+  void finish(const Model& m, const State& s) override;
   void columns(std::vector<std::string>& out) const override;
   void row(const Model& m, const State& s, std::vector<double>& out) const override;
   void summary(JsonObject& out) const override;
   std::string progress(const Model& m, const State& s) const override;
   void write_csv(const std::string& dir) const;
 
-  double theta_deg() const { return theta_deg_; }
+  double theta_deg() const { return theta_deg_; }  // the tilt asked for now (InclineFix applies it)
   double onset_deg() const { return onset_deg_; }  // < 0: none up to max_deg
   const Profile& profile() const { return prof_; }
   double mean_vx(const Model& m, const State& s) const;
@@ -91,13 +91,12 @@ class InclineObserver : public Observer {
   double end_vx() const { return end_vx_; }
   double end_dvdt() const { return end_dvdt_; }
   bool flowing() const { return flowing_; }
-  int glued() const { return glued_; }
+  int glued() const { return glued_; }  // grains glued to the plane at the end
   // rain with rest_speed > 0: whether the run ended with the deposit at rest, and when (s).
   bool rested() const { return rested_; }
   double rest_time() const { return rest_time_; }
 
  private:
-  void tilt(Model& m, State& s, double deg);
   void find_layers(const Model& m, const State& s);  // rain: base and top at the start of the window
   bool at_rest_check(const Model& m, const State& s);  // rain: true once every free grain is slow for rest_hold s
   InclineSpec sp_;
@@ -124,6 +123,25 @@ class InclineObserver : public Observer {
   Profile prof_;
 };
 
+// What the scene does to its run (a fix, run/fix.hpp): gravity tilted by the
+// measure's angle (from the start, and at each step of the onset protocol),
+// and, raining, every free grain that touches the plane glued where it is.
+class InclineFix : public Fix {
+ public:
+  InclineFix(const InclineSpec& sp, const InclineObserver& measure, double g, double floor_z)
+      : sp_(sp), measure_(measure), g_(g), floor_(floor_z) {}
+  void prepare(Model& m, State& s) override;
+  void after_step(const Stage& st, Model& m, State& s) override;
+  void after_measures(Model& m, State& s) override;
+
+ private:
+  void tilt(Model& m, State& s, double deg);
+  InclineSpec sp_;
+  const InclineObserver& measure_;
+  double g_, floor_;
+  double applied_deg_ = 0;
+};
+
 class InclineScene : public Scene {
  public:
   std::string kind() const override { return "incline"; }
@@ -142,6 +160,7 @@ class InclineRun : public SceneRun {
  public:
   InclineRun(const InclineScene& scene, const Model& m);
   std::vector<Observer*> observers() override { return {&obs_}; }
+  std::vector<Fix*> fixes() override { return {&fix_}; }
   void write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
                      int threads) const override;
   void write_files(const std::string& dir, const Model& m, const State& s, const RunReport& rep) const override;
@@ -152,6 +171,7 @@ class InclineRun : public SceneRun {
  private:
   const InclineScene& scene_;
   InclineObserver obs_;
+  InclineFix fix_;
 };
 
 std::shared_ptr<const SceneKind> incline_kind();

@@ -184,11 +184,11 @@ class LandingTrackerObserver : public Observer {
   // bed_top: grains above it are not bed (their touches do not count as bed contacts).
   LandingTrackerObserver(int lander, const LandingSpec& sp, double bed_top) : b_(lander), sp_(sp), bed_top_(bed_top) {}
   void start(const Model& m, const State& s) override;
-  bool after_step(Model& m, State& s) override;
+  bool after_step(const Model& m, const State& s) override;
   void columns(std::vector<std::string>& out) const override;
   void row(const Model& m, const State& s, std::vector<double>& out) const override;
   // The tracker's end figures and the far-field check (RMS grain speed in the container's outer ring).
-  void finish(Model& m, State& s) override;
+  void finish(const Model& m, const State& s) override;
   std::string progress(const Model& m, const State& s) const override;
   double time_left(const State& s) const override;
 

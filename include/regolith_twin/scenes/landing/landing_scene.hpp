@@ -37,7 +37,8 @@ class LandingScene : public Scene {
 class LandingRun : public SceneRun {
  public:
   LandingRun(const LandingScene& scene, const Model& m);
-  std::vector<Observer*> observers() override { return {&tracker_, &zone_, &ejecta_}; }
+  std::vector<Observer*> observers() override { return {&tracker_, &ejecta_}; }
+  std::vector<Fix*> fixes() override { return {&zone_}; }
   void write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
                      int threads) const override;
   void write_files(const std::string& dir, const Model& m, const State& s, const RunReport& rep) const override;

@@ -1,4 +1,4 @@
-// Plume erosion measurement (docs/scenes.md D): two horizontal planes that
+// Plume erosion (a fix, run/fix.hpp; docs/scenes.md D): two horizontal planes that
 // follow the eroding bed, the grains above the upper one counted every step.
 //
 // The anchoring plane (below it the gas does not act: GasField reads its
@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "regolith_twin/run/observer.hpp"
+#include "regolith_twin/run/fix.hpp"
 
 namespace rt {
 
@@ -56,12 +56,12 @@ struct ErosionRow {
   double touching_fraction = 0;  // grains above in contact with another above / N, moving average
 };
 
-class ErosionObserver : public Observer {
+class ErosionFix : public Fix {
  public:
-  explicit ErosionObserver(const ErosionPlanes& p) : p_(p) {}
+  explicit ErosionFix(const ErosionPlanes& p) : p_(p) {}
   void prepare(Model& m, State& s) override;
-  void start(const Model& m, const State& s) override;
-  bool after_step(Model& m, State& s) override;
+  void start(Model& m, State& s) override;
+  void after_measures(Model& m, State& s) override;
   void columns(std::vector<std::string>& out) const override;
   void row(const Model& m, const State& s, std::vector<double>& out) const override;
   void finish(Model& m, State& s) override;

@@ -79,7 +79,7 @@ class ImpulseObserver : public Observer {
   void start(const Model& m, const State& s) override;
   // Must run before an observer that moves the planes (it reads the planes
   // the step used).
-  bool after_step(Model& m, State& s) override;
+  bool after_step(const Model& m, const State& s) override;
   void columns(std::vector<std::string>& out) const override;
   void row(const Model& m, const State& s, std::vector<double>& out) const override;
   void summary(JsonObject& out) const override;

@@ -58,19 +58,20 @@ class PlumeRun : public SceneRun {
  public:
   PlumeRun(const PlumeScene& scene, const Model& m);
   // The impulse bookkeeping reads the planes the step used: before the erosion observer moves them.
-  std::vector<Observer*> observers() override { return {&impulse_, &erosion_}; }
+  std::vector<Observer*> observers() override { return {&impulse_}; }
+  std::vector<Fix*> fixes() override { return {&erosion_}; }
   void write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
                      int threads) const override;
   void write_files(const std::string& dir, const Model& m, const State& s, const RunReport& rep) const override;
   std::vector<std::pair<std::string, std::string>> files() const override;
   std::string result_line(const Model& m, const State& s, const RunReport& rep) const override;
-  const ErosionObserver& erosion() const { return erosion_; }
+  const ErosionFix& erosion() const { return erosion_; }
   const ImpulseObserver& impulse() const { return impulse_; }
 
  private:
   const PlumeScene& scene_;
   ImpulseObserver impulse_;
-  ErosionObserver erosion_;
+  ErosionFix erosion_;
 };
 
 // The plume kind for the registry.

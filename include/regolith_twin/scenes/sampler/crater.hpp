@@ -29,12 +29,12 @@ class Crater : public Observer {
   Crater(const Vec3& impact, int projectile, int every, double threshold = 0.5, double column_radius = 0.01,
          double layer = 1e-3, double max_depth = 0.15, double ring_depth = 0.01, double max_radius = 0.15);
   void start(const Model& m, const State& s) override;
-  bool after_step(Model& m, State& s) override;
+  bool after_step(const Model& m, const State& s) override;
   void grains_removed(const std::vector<int>& old_to_new) override;
   void grains_added(const Model& m, const State& s, int first) override { not_bed_.added(first, m.n_grains); }
   void columns(std::vector<std::string>& out) const override;
   void row(const Model& m, const State& s, std::vector<double>& out) const override;
-  void finish(Model& m, State& s) override { measure(m, s); }
+  void finish(const Model& m, const State& s) override { measure(m, s); }
   void summary(JsonObject& out) const override;
 
   double depth() const { return depth_; }    // m

@@ -41,7 +41,7 @@ class HornSegments : public Observer {
   void grains_added(const Model& m, const State& s, int first) override { not_bed_.added(first, m.n_grains); }
   void columns(std::vector<std::string>& out) const override;
   void row(const Model& m, const State& s, std::vector<double>& out) const override;
-  void finish(Model& m, State& s) override { count(m, s); }
+  void finish(const Model& m, const State& s) override { count(m, s); }
   void summary(JsonObject& out) const override;
   std::string progress(const Model& m, const State& s) const override;
 

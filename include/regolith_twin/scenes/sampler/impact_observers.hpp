@@ -30,7 +30,7 @@ class ImpactClock : public Observer {
  public:
   explicit ImpactClock(int projectile) : projectile0_(projectile), projectile_(projectile) {}
   void start(const Model& m, const State& s) override;
-  bool after_step(Model& m, State& s) override;
+  bool after_step(const Model& m, const State& s) override;
   void grains_removed(const std::vector<int>& old_to_new) override;
   void summary(JsonObject& out) const override;
 
@@ -88,7 +88,7 @@ class EjectionAngles : public Observer {
   EjectionAngles(const ImpactClock* clock, double surface_height, const Vec3& axis, double container_radius,
                  double g, int every);
   void start(const Model& m, const State& s) override;
-  bool after_step(Model& m, State& s) override;
+  bool after_step(const Model& m, const State& s) override;
   void grains_removed(const std::vector<int>& old_to_new) override;
   // Grains added during the run (a second projectile) are not bed grains.
   void grains_added(const Model& m, const State& s, int first) override { done_.resize(m.n_grains, 1); }
@@ -147,7 +147,7 @@ class EnergyPartition : public Observer {
  public:
   EnergyPartition(const ImpactClock* clock, int every, double window = 2e-4);
   void start(const Model& m, const State& s) override;
-  bool after_step(Model& m, State& s) override;
+  bool after_step(const Model& m, const State& s) override;
   void summary(JsonObject& out) const override;
 
   double initial_energy() const { return e0_; }                   // J
@@ -224,7 +224,7 @@ class WaveAttenuation : public Observer {
  public:
   WaveAttenuation(const ImpactClock* clock, const WaveOptions& opt);
   void start(const Model& m, const State& s) override;
-  bool after_step(Model& m, State& s) override;
+  bool after_step(const Model& m, const State& s) override;
   void summary(JsonObject& out) const override;
 
   double rest_rms() const { return rest_rms_; }
@@ -263,7 +263,7 @@ class ZModelSampler : public Observer {
   ZModelSampler(const ImpactClock* clock, const ZFitOptions& base, double rest_rms,
                 std::vector<double> times = {45e-6, 1.25e-3, 12.5e-3}, double factor = 10);
   void start(const Model& m, const State& s) override;
-  bool after_step(Model& m, State& s) override;
+  bool after_step(const Model& m, const State& s) override;
   void summary(JsonObject& out) const override;
 
   double rest_rms() const { return rest_rms_; }

@@ -17,7 +17,7 @@ class PackingBelowFilter : public Observer {
  public:
   explicit PackingBelowFilter(const HornGeometry& g, double slice = 1e-3, int slices = 45)
       : g_(g), slice_(slice), n_(slices) {}
-  void finish(Model& m, State& s) override { prof_ = profile(m, s); }
+  void finish(const Model& m, const State& s) override { prof_ = profile(m, s); }
   void summary(JsonObject& out) const override;
   // Solid fraction of slice k = [filter_bottom - (k+1) slice, filter_bottom - k slice] (horn frame).
   std::vector<double> profile(const Model& m, const State& s) const;

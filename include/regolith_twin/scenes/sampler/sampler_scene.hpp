@@ -81,7 +81,7 @@ class SamplerScene : public Scene {
 // The optional second projectile (docs/scenes.md B): second_delay after the
 // first, a grain like the first is added on the horn axis at the bottom of
 // cylinder 4, moving along the first one's direction at the shot speed.
-class SecondShot : public Observer {
+class SecondShot : public Fix {
  public:
   explicit SecondShot(const SamplerScene& sc);
   void add_grains(Model& m, State& s) override;
@@ -103,8 +103,9 @@ class SamplerRun : public SceneRun {
  public:
   SamplerRun(const SamplerScene& sc, const Model& m);
   std::vector<Observer*> observers() override {
-    return {&clock_, &segments_, &escape_, &ejecta_, &energy_, &wave_, &zfit_, &crater_, &packing_, &second_};
+    return {&clock_, &segments_, &escape_, &ejecta_, &energy_, &wave_, &zfit_, &crater_, &packing_};
   }
+  std::vector<Fix*> fixes() override { return {&second_}; }
   void write_summary(const std::string& path, const Model& m, const State& s, const RunReport& rep,
                      int threads) const override;
   void write_files(const std::string& dir, const Model& m, const State& s, const RunReport& rep) const override;

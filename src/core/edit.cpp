@@ -1,6 +1,7 @@
 // Editing the grains of a scene between steps (see edit.hpp): per-grain
 // arrays compacted or extended, contact lists renumbered with their springs.
 #include "regolith_twin/core/edit.hpp"
+#include "regolith_twin/core/hold.hpp"
 #include "regolith_twin/core/types.hpp"
 
 #include <algorithm>
@@ -116,7 +117,7 @@ void check_sizes(const Model& m, const State& s, const char* what) {
     if (v->size() != n) throw std::logic_error(std::string(what) + ": the state does not match the model's grain count");
   for (const std::vector<double>* v : {&m.grain_radius, &m.grain_mass, &m.grain_inv_mass, &m.grain_inv_inertia})
     if (v->size() != n) throw std::logic_error(std::string(what) + ": the model's grain arrays are not finalized");
-  if (m.grain_material.size() != n || m.grain_fixed.size() != n)
+  if (m.grain_material.size() != n || m.grain_hold.size() != n)
     throw std::logic_error(std::string(what) + ": the model's grain arrays are not finalized");
 }
 
@@ -165,7 +166,7 @@ int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vec
   compact(m.grain_radius, map, kept);
   compact(m.grain_mass, map, kept);
   compact(m.grain_material, map, kept);
-  compact(m.grain_fixed, map, kept);
+  compact(m.grain_hold, map, kept);
   compact(m.grain_inv_mass, map, kept);
   compact(m.grain_inv_inertia, map, kept);
   m.n_grains = kept;
@@ -211,20 +212,6 @@ int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vec
   return n - kept;
 }
 
-void hold_grain(Model& m, State& s, int i) {
-  m.grain_fixed[i] = 1;
-  m.grain_inv_mass[i] = 0;
-  m.grain_inv_inertia[i] = 0;
-  s.vel[i].setZero();
-  s.omega[i].setZero();
-}
-
-void free_grain(Model& m, int i, double inv_mass, double inv_inertia) {
-  m.grain_fixed[i] = 0;
-  m.grain_inv_mass[i] = inv_mass;
-  m.grain_inv_inertia[i] = inv_inertia;
-}
-
 int add_grain(Model& m, State& s, double radius, int material, const Vec3& pos, const Vec3& vel, const Vec3& omega) {
   if (!(radius > 0)) throw InputError("add_grain: radius must be > 0 m");
   if (material < 0 || material >= m.n_materials()) throw InputError("add_grain: unknown material index");
@@ -234,8 +221,9 @@ int add_grain(Model& m, State& s, double radius, int material, const Vec3& pos, 
   // Mass and inertia as finalize_model derives them.
   const double mass = 4.0 / 3.0 * kPi * radius * radius * radius * m.materials[material].density;
   m.grain_mass.push_back(mass);
-  m.grain_inv_mass.push_back(1.0 / mass);
-  m.grain_inv_inertia.push_back(1.0 / (0.4 * mass * radius * radius));
+  const InverseMass im = grain_inverse_mass(m, i);
+  m.grain_inv_mass.push_back(im.mass);
+  m.grain_inv_inertia.push_back(im.inertia);
   m.max_radius = std::max(m.max_radius, radius);
   m.min_radius = n ? std::min(m.min_radius, radius) : radius;
   m.single_grain_material = n == 0 || m.single_grain_material == material ? material : -1;

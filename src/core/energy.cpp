@@ -1,5 +1,6 @@
 // Energy bookkeeping from a state (not part of the step; called by observers).
 #include "regolith_twin/core/energy.hpp"
+#include "regolith_twin/core/hold.hpp"
 
 #include <cmath>
 #include <vector>
@@ -96,7 +97,7 @@ void for_each_elastic_contact(const Model& m, const State& s, const std::functio
 Energy energy(const Model& m, const State& s) {
   Energy e;
   for (int i = 0; i < m.n_grains; ++i) {
-    if (m.grain_inv_mass[i] == 0) continue;
+    if (held(m, i)) continue;
     const double mass = m.grain_mass[i];
     e.translational += 0.5 * mass * s.vel[i].squaredNorm();
     e.rotational += 0.5 * (1.0 / m.grain_inv_inertia[i]) * s.omega[i].squaredNorm();
@@ -117,7 +118,7 @@ Energy energy(const Model& m, const State& s) {
 double kinetic_energy(const Model& m, const State& s) {
   double e = 0;
   for (int i = 0; i < m.n_grains; ++i) {
-    if (m.grain_inv_mass[i] == 0) continue;
+    if (held(m, i)) continue;
     e += 0.5 * m.grain_mass[i] * s.vel[i].squaredNorm() + 0.5 * (1.0 / m.grain_inv_inertia[i]) * s.omega[i].squaredNorm();
   }
   for (size_t b = 0; b < m.bodies.size(); ++b)
@@ -127,7 +128,7 @@ double kinetic_energy(const Model& m, const State& s) {
 
 double coordination_number(const Model& m, const State& s) {
   long free_grains = 0;
-  for (int i = 0; i < m.n_grains; ++i) free_grains += m.grain_inv_mass[i] != 0;
+  for (int i = 0; i < m.n_grains; ++i) free_grains += !held(m, i);
   return free_grains ? 2.0 * double(s.stats.contacts) / double(free_grains) : 0.0;
 }
 

@@ -2,6 +2,7 @@
 // own force buffer (partition 0 writes State::force directly); buffers are
 // merged in partition order, then wall contacts are added grain by grain.
 #include "regolith_twin/core/forces.hpp"
+#include "regolith_twin/core/hold.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -863,7 +864,7 @@ void woken_contacts(const Model& m, State& s, const std::vector<uint8_t>& woken)
   const double dt = m.dt;
   const int nm = m.n_materials();
   // Idle before the wake: asleep then (still asleep, or woken now) or glued.
-  const auto idle_before = [&](int i) { return s.sleep.asleep[i] || woken[i] || m.grain_inv_mass[i] == 0; };
+  const auto idle_before = [&](int i) { return s.sleep.asleep[i] || woken[i] || held(m, i); };
   for (int k = 0; k < pl.size(); ++k) {
     const int i = pl.owner[k], j = pl.partner[k];
     if (!(woken[i] || woken[j]) || !idle_before(i) || !idle_before(j)) continue;

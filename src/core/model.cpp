@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "regolith_twin/core/hold.hpp"
 #include "regolith_twin/core/model.hpp"
 #include "regolith_twin/core/types.hpp"
 
@@ -107,7 +108,7 @@ double hertz_contact_time(double mstar, double reff, double e_star, double v) {
 int add_grain(Model& m, double radius, int material, bool fixed) {
   m.grain_radius.push_back(radius);
   m.grain_material.push_back(material);
-  m.grain_fixed.push_back(fixed ? 1 : 0);
+  m.grain_hold.push_back(fixed ? kHoldGlued : 0);
   return m.n_grains++;
 }
 
@@ -168,9 +169,10 @@ void finalize_model(Model& m) {
     if (mat < 0 || mat >= nm) throw InputError("model: grain " + std::to_string(i) + " has an unknown material");
     const double mass = 4.0 / 3.0 * kPi * r * r * r * m.materials[mat].density;
     m.grain_mass[i] = mass;
-    if (!m.grain_fixed[i]) {
-      m.grain_inv_mass[i] = 1.0 / mass;
-      m.grain_inv_inertia[i] = 1.0 / (0.4 * mass * r * r);
+    if (!held(m, i)) {
+      const InverseMass im = grain_inverse_mass(m, i);
+      m.grain_inv_mass[i] = im.mass;
+      m.grain_inv_inertia[i] = im.inertia;
     }
     m.max_radius = std::max(m.max_radius, r);
     m.min_radius = std::min(m.min_radius, r);

@@ -1,5 +1,6 @@
 // Neighbours stage: counting-sort cell lists, half pair list, wall list,
 // history carry-over and the fixed work partition.
+#include "regolith_twin/core/hold.hpp"
 #include "regolith_twin/core/neighbours.hpp"
 
 #include <algorithm>
@@ -172,8 +173,8 @@ void row_partners(const Model& m, const State& s, const Grid& g, int i, std::vec
     for (int q = s.cell_start[cc]; q < s.cell_start[cc + 1]; ++q) {
       const int j = s.cell_items[q];
       if (j <= i) continue;
-      if (m.grain_fixed[i] && m.grain_fixed[j]) continue;  // glued pairs never interact
-      if (!m.mobile_contacts && !m.grain_fixed[i] && !m.grain_fixed[j]) continue;  // collisionless
+      if (held(m, i) && held(m, j)) continue;  // pairs of held grains never interact
+      if (!m.mobile_contacts && !held(m, i) && !held(m, j)) continue;  // collisionless
       const double cut = ri + m.grain_radius[j] + skin;
       if ((s.pos[j] - xi).squaredNorm() < cut * cut) out.push_back(j);
     }
@@ -241,8 +242,8 @@ void row_partners_periodic(const Model& m, const State& s, const Grid& g, int i,
     for (int q = s.cell_start[cc]; q < s.cell_start[cc + 1]; ++q) {
       const int j = s.cell_items[q];
       if (j <= i) continue;
-      if (m.grain_fixed[i] && m.grain_fixed[j]) continue;  // glued pairs never interact
-      if (!m.mobile_contacts && !m.grain_fixed[i] && !m.grain_fixed[j]) continue;  // collisionless
+      if (held(m, i) && held(m, j)) continue;  // pairs of held grains never interact
+      if (!m.mobile_contacts && !held(m, i) && !held(m, j)) continue;  // collisionless
       Vec3 d = s.pos[j] - xi;
       int sx = 0, sy = 0;
       if (p.x) {
@@ -327,7 +328,7 @@ void build_walls(const Model& m, State& s) {
   nl.wall.clear();
   const int nw = static_cast<int>(m.walls.size());
   for (int i = 0; i < m.n_grains; ++i) {
-    if (m.grain_fixed[i]) continue;
+    if (held(m, i)) continue;
     for (int w = 0; w < nw; ++w) {
       if (!s.wall_on[w]) continue;
       if (wall_gap(m.walls[w], s.pos[i], m.grain_radius[i]).overlap > -m.skin) {
@@ -658,7 +659,7 @@ void build_reach(const Model& m, State& s, const Grid& g) {
   long count = 0;
 #pragma omp parallel for schedule(static) reduction(+ : count) if (n >= m.parallel_min_grains)
   for (int i = 0; i < n; ++i) {
-    if (listed[i] || m.grain_inv_mass[i] == 0) continue;
+    if (listed[i] || held(m, i)) continue;
     s.reach[i] = grain_reach(m, s, g, i);
     ++count;
   }

@@ -1,5 +1,6 @@
 // Sleep stage (docs/model.md §16): cells of quiet grains leave the step.
 #include "regolith_twin/core/sleep.hpp"
+#include "regolith_twin/core/hold.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -287,7 +288,7 @@ void update_sleep(const Model& m, State& s) {
       if (c >= 0) z.cell_flags[c] |= kHasSleeper;
       continue;
     }
-    if (!check || m.grain_inv_mass[i] == 0) continue;  // glued grains neither move nor sleep
+    if (!check || held(m, i)) continue;  // glued grains neither move nor sleep
     const double r = m.grain_radius[i];
     const double v2 = s.vel[i].squaredNorm() + s.omega[i].squaredNorm() * r * r;
     vmax = std::max(vmax, std::sqrt(v2));
@@ -341,7 +342,7 @@ void update_sleep(const Model& m, State& s) {
     for (int i = 0; i < n; ++i) {
       const int c = z.cell_scratch[i];
       // A grain touching nothing is in flight (a rattler in its cage, an ejected grain): it stays awake.
-      if (c < 0 || z.asleep[i] || z.quiet[c] < th.time || m.grain_inv_mass[i] == 0 || !touch[i]) continue;
+      if (c < 0 || z.asleep[i] || z.quiet[c] < th.time || held(m, i) || !touch[i]) continue;
       const double im = m.grain_inv_mass[i], ii = m.grain_inv_inertia[i];
       z.discarded_energy += 0.5 * s.vel[i].squaredNorm() / im + (ii > 0 ? 0.5 * s.omega[i].squaredNorm() / ii : 0);
       z.discarded_max_speed = std::max(z.discarded_max_speed, s.vel[i].norm());

@@ -1,5 +1,6 @@
 // The time step: a short pipeline of stages (see step.hpp).
 #include "regolith_twin/core/step.hpp"
+#include "regolith_twin/core/hold.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -137,7 +138,7 @@ void EnergyWatch::check(const Model& m, const State& s) {
   double d_sum = 0;
   for (int i = 0; i < m.n_grains; ++i) {
     d_sum += 2 * m.grain_radius[i];
-    if (m.grain_inv_mass[i] == 0) {
+    if (held(m, i)) {
       ++frozen;
       frozen_sum += i;
     } else {
@@ -167,7 +168,7 @@ void EnergyWatch::check(const Model& m, const State& s) {
     int fast = -1;
     double v2 = -1;
     for (int i = 0; i < m.n_grains; ++i)
-      if (m.grain_inv_mass[i] != 0 && s.vel[i].squaredNorm() > v2) {
+      if (!held(m, i) && s.vel[i].squaredNorm() > v2) {
         v2 = s.vel[i].squaredNorm();
         fast = i;
       }
@@ -225,7 +226,7 @@ void check_guards(const Model& m, const State& s) {
     int g = -1;
     double v2 = -1;
     for (int i = 0; i < m.n_grains; ++i)
-      if ((s.reach.empty() || !(s.reach[i] > 0)) && m.grain_inv_mass[i] != 0 && s.vel_mid[i].squaredNorm() > v2) {
+      if ((s.reach.empty() || !(s.reach[i] > 0)) && !held(m, i) && s.vel_mid[i].squaredNorm() > v2) {
         v2 = s.vel_mid[i].squaredNorm();
         g = i;
       }

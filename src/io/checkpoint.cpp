@@ -33,7 +33,9 @@ constexpr uint32_t kVersion = 8;
 uint64_t model_fingerprint(const Model& m) {
   uint64_t h = fnv1a(reinterpret_cast<const char*>(m.grain_radius.data()), m.grain_radius.size() * sizeof(double));
   h = fnv1a(reinterpret_cast<const char*>(m.grain_material.data()), m.grain_material.size() * sizeof(int), h);
-  return fnv1a(reinterpret_cast<const char*>(m.grain_fixed.data()), m.grain_fixed.size(), h);
+  std::vector<uint8_t> held_now(m.grain_hold.size());  // held or free, whichever policy
+  for (size_t i = 0; i < held_now.size(); ++i) held_now[i] = m.grain_hold[i] != 0;
+  return fnv1a(reinterpret_cast<const char*>(held_now.data()), held_now.size(), h);
 }
 
 class Writer {

@@ -1,4 +1,5 @@
 // Compact bed snapshots, float32 or float64 (see snapshot.hpp).
+#include "regolith_twin/core/hold.hpp"
 #include "regolith_twin/io/snapshot.hpp"
 
 #include "regolith_twin/core/hash.hpp"
@@ -24,10 +25,10 @@ void write_snapshot(const std::string& path, const Model& m, const State& s, boo
   const bool wide = precision == SnapshotPrecision::Float64;
   std::string buf(wide ? kMagic64 : kMagic, 8);
   uint64_t n = 0;
-  for (int i = 0; i < m.n_grains; ++i) n += include_fixed || !m.grain_fixed[i];
+  for (int i = 0; i < m.n_grains; ++i) n += include_fixed || !held(m, i);
   buf.append(reinterpret_cast<const char*>(&n), sizeof n);
   for (int i = 0; i < m.n_grains; ++i) {
-    if (!include_fixed && m.grain_fixed[i]) continue;
+    if (!include_fixed && held(m, i)) continue;
     if (wide) {
       const double rec[4] = {s.pos[i].x(), s.pos[i].y(), s.pos[i].z(), m.grain_radius[i]};
       buf.append(reinterpret_cast<const char*>(rec), sizeof rec);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "regolith_twin/core/hold.hpp"
 #include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/core/types.hpp"
 #include "regolith_twin/core/step.hpp"
@@ -55,9 +56,9 @@ bool Ejecta::after_step(const Model& m, const State& s) {
 // --- active zone ----------------------------------------------------------------
 
 void ActiveZone::prepare(Model& m, State& s) {
-  inv_mass_ = m.grain_inv_mass;
-  inv_inertia_ = m.grain_inv_inertia;
-  fixed0_ = m.grain_fixed;
+  // Grains another policy holds at the start (glued by the scene) are left alone.
+  fixed0_.assign(m.n_grains, 0);
+  for (int i = 0; i < m.n_grains; ++i) fixed0_[i] = held(m, i);
   woken_.assign(m.n_grains, 0);
   update(m, s, s.bodies[body_].pos, true);
   // Lists and forces for the frozen model (and any rebuild already pending).
@@ -79,10 +80,10 @@ bool ActiveZone::update(Model& m, State& s, const Vec3& c, bool first) {
     const bool inside = std::hypot(s.pos[i].x() - c.x(), s.pos[i].y() - c.y()) < radius_;
     if (inside) {
       woken_[i] = 1;
-      free_grain(m, i, inv_mass_[i], inv_inertia_[i]);
+      release_grain(m, i, kHoldOutsideZone);
       changed = changed || !first;
     } else if (first) {
-      hold_grain(m, s, i);
+      hold_grain(m, s, i, kHoldOutsideZone);
       changed = true;
     }
   }
@@ -95,10 +96,10 @@ void ActiveZone::finish(Model& m, State& s) {
   long cnt = 0;
   active_ = 0;
   for (int i = 0; i < m.n_grains; ++i) {
-    active_ += m.grain_inv_mass[i] != 0;
+    active_ += !held(m, i);
     const double d = std::hypot(s.pos[i].x() - last_.x(), s.pos[i].y() - last_.y());
     const bool ejected = ejecta_ && ejecta_->ejected(i);
-    if (radius_ > 0 && m.grain_inv_mass[i] != 0 && !ejected && d > radius_ - ring_) {
+    if (radius_ > 0 && !held(m, i) && !ejected && d > radius_ - ring_) {
       sum += s.vel[i].squaredNorm();
       ++cnt;
     }
@@ -218,8 +219,6 @@ void Ejecta::grains_removed(const std::vector<int>& old_to_new) {
 }
 
 void ActiveZone::grains_removed(const std::vector<int>& old_to_new) {
-  renumber_grains(inv_mass_, old_to_new);
-  renumber_grains(inv_inertia_, old_to_new);
   renumber_grains(fixed0_, old_to_new);
   renumber_grains(woken_, old_to_new);
 }

@@ -1,5 +1,6 @@
 // The ROS adapter over rt::Twin (see twin_node.hpp and docs/ros.md).
 #include "regolith_twin/ros/twin_node.hpp"
+#include "regolith_twin/core/hold.hpp"
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -553,7 +554,7 @@ void TwinNode::publish_status() {
   msg.paused = paused_;
   msg.grains = uint32_t(m.n_grains);
   uint32_t frozen = 0;
-  for (int i = 0; i < m.n_grains; ++i) frozen += m.grain_inv_mass[i] == 0;
+  for (int i = 0; i < m.n_grains; ++i) frozen += held(m, i);
   msg.frozen_grains = frozen;
   msg.active_grains = uint32_t(m.n_grains) - frozen;
   msg.max_overlap_ratio = s.stats.max_overlap_ratio;

@@ -1,4 +1,5 @@
 // Relax-once-and-cache beds (see bed_cache.hpp).
+#include "regolith_twin/core/hold.hpp"
 #include "regolith_twin/run/bed_cache.hpp"
 
 #include <algorithm>
@@ -23,7 +24,7 @@ void save_grains(const std::string& path, const Scenario& sc) {
   const Model& m = sc.model;
   f << m.n_grains << ' ' << sc.groups.size() << '\n';
   for (int i = 0; i < m.n_grains; ++i)
-    f << m.grain_radius[i] << ' ' << m.grain_material[i] << ' ' << int(m.grain_fixed[i]) << '\n';
+    f << m.grain_radius[i] << ' ' << m.grain_material[i] << ' ' << int(held(m, i)) << '\n';
   for (const GrainGroup& g : sc.groups) f << g.name << ' ' << g.first << ' ' << g.count << '\n';
   write_file(path, f.str());
 }
@@ -41,7 +42,7 @@ void load_grains(const std::string& path, Scenario& sc) {
     int fx = 0;
     if (!(f >> r[i] >> mat[i] >> fx) || !(r[i] > 0) || mat[i] < 0 || mat[i] >= m.n_materials())
       throw InputError(path + ": not a usable grain list of a cut bed (grain " + std::to_string(i) + ")");
-    fixed[i] = fx != 0;
+    fixed[i] = fx != 0 ? kHoldGlued : 0;
   }
   std::vector<GrainGroup> groups(ng);
   for (GrainGroup& g : groups)
@@ -49,7 +50,7 @@ void load_grains(const std::string& path, Scenario& sc) {
       throw InputError(path + ": not a usable grain list of a cut bed (groups)");
   m.grain_radius = std::move(r);
   m.grain_material = std::move(mat);
-  m.grain_fixed = std::move(fixed);
+  m.grain_hold = std::move(fixed);
   m.n_grains = int(n);
   finalize_model(m);
   sc.groups = std::move(groups);
@@ -160,7 +161,7 @@ RelaxedBed relax_bed(Scenario& sc, const State& s0, const std::vector<int>& plac
   if (relax.model.n_grains != sc.model.n_grains) {  // a cut: the bed's grains replace the scenario's
     sc.model.grain_radius = relax.model.grain_radius;
     sc.model.grain_material = relax.model.grain_material;
-    sc.model.grain_fixed = relax.model.grain_fixed;
+    sc.model.grain_hold = relax.model.grain_hold;
     sc.model.n_grains = relax.model.n_grains;
     finalize_model(sc.model);
     sc.groups = relax.groups;

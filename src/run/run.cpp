@@ -1,5 +1,6 @@
 // The one run loop (see run.hpp).
 #include "regolith_twin/run/run.hpp"
+#include "regolith_twin/core/hold.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -22,7 +23,7 @@ GrainSpeeds grain_speeds(const Model& m, const State& s, const std::vector<uint8
   double sum = 0, mx = 0;
   long n = 0;
   for (int i = 0; i < m.n_grains; ++i) {
-    if (m.grain_inv_mass[i] == 0 || skip[i]) continue;
+    if (held(m, i) || skip[i]) continue;
     const double v2 = s.vel[i].squaredNorm();
     sum += v2;
     mx = std::max(mx, v2);
@@ -134,6 +135,8 @@ void Run::begin_stage() {
   sr_ = StageReport{st.name, 0, "duration"};
   for (Fix* f : fixes_) f->stage_start(st, m_, s_, sr_);
   t_stage_end_ = s_.time + st.duration;
+  stage_t0_ = s_.time;
+  stage_wall0_ = Clock::now();
   next_check_ = s_.time + st.check_every;
   in_stage_ = true;
 }
@@ -252,8 +255,14 @@ void Run::progress() {
   last_progress_ = now;
   const double wall = std::chrono::duration<double>(now - t0_).count();
   const double steps_s = double(s_.step - step0_) / std::max(wall, 1e-9);
-  const double rate = (s_.time - t_start_) / std::max(wall, 1e-9);
-  // Time left: the rest of the stages with a duration, or what the observers know.
+  // Simulated seconds per wall second: of this stage once it has run a while
+  // (stages differ in cost: a relaxation beside a landing), else of the run.
+  const double stage_wall = std::chrono::duration<double>(now - stage_wall0_).count();
+  const double rate = stage_wall >= 2 * opt_.progress_every
+                          ? (s_.time - stage_t0_) / stage_wall
+                          : (s_.time - t_start_) / std::max(wall, 1e-9);
+  // Time left: the rest of the stages with a duration, or what the measures
+  // expect (an estimate) or know as a bound.
   double left = 0, total = s_.time;
   bool bounded = true;
   for (size_t q = k_; q < plan_.stages.size(); ++q) {
@@ -263,24 +272,34 @@ void Run::progress() {
   }
   total += left;
   std::string text;
-  double obs_left = -1;
+  double obs_left = -1, expected = -1;
   for (const Observer* o : obs_) {
     const std::string p = o->progress(m_, s_);
     if (!p.empty()) text += "  " + p;
     const double l = o->time_left(s_);
     if (l >= 0) obs_left = obs_left < 0 ? l : std::min(obs_left, l);
+    const double e = o->expected_time_left(s_);
+    if (e >= 0) expected = expected < 0 ? e : std::min(expected, e);
   }
+  const auto wall_text = [&](double sim) { return clock_text(sim / std::max(rate, 1e-300)); };
   std::string eta = "ETA ?";
-  if (bounded) eta = "ETA " + clock_text(left / std::max(rate, 1e-300));
-  else if (obs_left >= 0) eta = "at most " + clock_text(obs_left / std::max(rate, 1e-300));
+  if (bounded) eta = "ETA " + wall_text(left);
+  else if (expected >= 0) eta = "ETA ~" + wall_text(expected);
+  else if (obs_left >= 0) eta = "at most " + wall_text(obs_left);
   char head[256];
-  if (bounded)
+  if (bounded) {
     std::snprintf(head, sizeof head, "[%s] stage %zu/%zu '%s'  t = %.4g s of %.4g s (%.0f %%)", plan_.name.c_str(),
                   k_ + 1, plan_.stages.size(), plan_.stages[k_].name.c_str(), s_.time, total,
                   total > 0 ? 100 * s_.time / total : 100.0);
-  else
+  } else if (expected >= 0) {  // the share of the stage done, as expected
+    const double done = s_.time - stage_t0_;
+    std::snprintf(head, sizeof head, "[%s] %s  t = %.4g s of ~%.4g s (~%.0f %%)", plan_.name.c_str(),
+                  plan_.stages[k_].name.c_str(), s_.time, s_.time + expected,
+                  done + expected > 0 ? 100 * done / (done + expected) : 100.0);
+  } else {
     std::snprintf(head, sizeof head, "[%s] %s  t = %.4g s", plan_.name.c_str(), plan_.stages[k_].name.c_str(),
                   s_.time);
+  }
   if (sleep_active(m_, s_)) {
     char b[64];
     std::snprintf(b, sizeof b, "  awake %zu", s_.sleep.awake.size());

@@ -1,5 +1,6 @@
 // The run's own fixes (see stage_fixes.hpp).
 #include "regolith_twin/run/stage_fixes.hpp"
+#include "regolith_twin/core/hold.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -96,7 +97,7 @@ void StageDamping::after_step(const Stage& st, Model& m, State& s) {
     const Vec3 g = m.gravity;
 #pragma omp parallel for schedule(static) if (n >= m.parallel_min_grains)
     for (int i = 0; i < n; ++i) {
-      if (m.grain_inv_mass[i] == 0) continue;
+      if (held(m, i)) continue;
       const Vec3 f = s.force[i] + g / m.grain_inv_mass[i];
       const double p = s.vel[i].dot(f), f2 = f.squaredNorm();
       s.vel[i] = p > 0 && f2 > 0 ? Vec3(f * (p / f2)) : Vec3::Zero();

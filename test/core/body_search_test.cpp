@@ -171,7 +171,7 @@ TEST(BodySearch, NoGrainsAndAllFarAway) {
   Scene two = make_scene(2, rng, 0.003);
   two.s.pos[0] = Vec3(0, 0, 0);
   two.s.pos[1] = Vec3(1000, -1000, 500);
-  two.m.grain_fixed.assign(2, 0);
+  two.m.grain_hold.assign(2, 0);
   two.m.grain_inv_mass.assign(2, 1.0);
   two.s.bodies[0].pos = two.s.pos[1] + Vec3(0, 0, 0.02);
   two.s.bodies[1].pos = two.s.pos[0] - Vec3(0, 0, 0.01);

@@ -194,7 +194,7 @@ void removal_keeps_run(bool with_body) {
   ASSERT_EQ(b.m.n_grains, a.m.n_grains);
   int next = 0;
   for (size_t i = 0; i < extra.size(); ++i) EXPECT_EQ(old_to_new[i], extra[i] ? -1 : next++);
-  EXPECT_EQ(b.m.grain_fixed, a.m.grain_fixed);
+  EXPECT_EQ(b.m.grain_hold, a.m.grain_hold);
   EXPECT_EQ(b.m.grain_inv_mass, a.m.grain_inv_mass);
   // Before any step the renumbered lists are the reference's lists.
   expect_same(a.s, b.s);

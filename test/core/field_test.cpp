@@ -92,7 +92,7 @@ Bed make_bed(int n, double r, double L, double spacing, int glued_every = 0) {
   std::normal_distribution<double> v(0.0, 0.1);
   for (int i = 0; i < n; ++i) {
     b.s.pos[i] = sites[i];
-    if (!m.grain_fixed[i]) b.s.vel[i] = Vec3(v(rng), v(rng), v(rng) - 1.0);
+    if (!m.grain_hold[i]) b.s.vel[i] = Vec3(v(rng), v(rng), v(rng) - 1.0);
   }
   return b;
 }

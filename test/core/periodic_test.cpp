@@ -178,7 +178,7 @@ TEST(Periodic, BitIdenticalForAnyThreadCountAndKernel) {
 
 TEST(Periodic, GluedGrainsAreImaged) {
   rt::Model m = grains(2, true);
-  m.grain_fixed[0] = 1;
+  m.grain_hold[0] = 1;
   rt::finalize_model(m);
   rt::State s = rt::make_state(m);
   s.pos[0] = Vec3(kL - 0.9e-3, 5e-3, 1e-3);  // glued, by the x = L side

@@ -26,12 +26,6 @@ int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vec
 // Throws InputError for a radius <= 0 or an unknown material.
 int add_grain(Model& m, State& s, double radius, int material, const Vec3& pos, const Vec3& vel, const Vec3& omega);
 
-// Hold grain i in place (infinite mass, at rest), or free it again with its
-// own inverse mass and inertia. Lists and pair constants follow at the next
-// rebuild: the caller sets s.rebuild_requested.
-void hold_grain(Model& m, State& s, int i);
-void free_grain(Model& m, int i, double inv_mass, double inv_inertia);
-
 // Rotate every grain about the vertical axis through the origin by `angle`
 // (rad), with its velocities, forces and springs (a bed turned for a
 // perturbed repeat of a run).

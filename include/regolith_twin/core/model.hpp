@@ -180,9 +180,9 @@ struct Model {
   std::vector<double> grain_radius;    // r, m (n_grains)
   std::vector<double> grain_mass;      // m, kg (n_grains)
   std::vector<int> grain_material;     // material index (n_grains)
-  std::vector<uint8_t> grain_fixed;    // 1 = glued in place (infinite mass) (n_grains)
-  std::vector<double> grain_inv_mass;     // 1/m, 1/kg; 0 for fixed grains (n_grains)
-  std::vector<double> grain_inv_inertia;  // 1/I, 1/(kg m^2); 0 for fixed grains (n_grains)
+  std::vector<uint8_t> grain_hold;     // policies holding the grain at rest, 0 = free (core/hold.hpp) (n_grains)
+  std::vector<double> grain_inv_mass;     // 1/m, 1/kg; 0 for held grains (n_grains)
+  std::vector<double> grain_inv_inertia;  // 1/I, 1/(kg m^2); 0 for held grains (n_grains)
 
   // --- materials and the pair-law table ---
   ContactModel contact_model = ContactModel::Linear;

@@ -36,7 +36,6 @@ class ActiveZone : public Fix {
   double radius_, ring_;
   int every_;
   const Ejecta* ejecta_;
-  std::vector<double> inv_mass_, inv_inertia_;
   std::vector<uint8_t> fixed0_, woken_;
   Vec3 last_ = Vec3::Zero();
   long active_ = 0;

@@ -44,6 +44,9 @@ class Observer {
   virtual std::string progress(const Model& m, const State& s) const { return ""; }
   // Simulated time left at most, s, when the measure knows it (< 0: it does not).
   virtual double time_left(const State& s) const { return -1; }
+  // Simulated time left as the measure expects it, s: an estimate, not a bound
+  // (< 0: it has none). The progress line's ETA prefers it to the bound.
+  virtual double expected_time_left(const State& s) const { return -1; }
 };
 
 }  // namespace rt

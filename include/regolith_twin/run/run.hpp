@@ -10,8 +10,9 @@
 // called at named points of the step: before it, after it, when grains join,
 // after the measures, at its end). The run's own fixes carry out the stages
 // (stage_fixes.hpp: trim, stiffness, gravity, damping, held groups) and the
-// stiffness schedule; a scene adds its own (the active zone, a second
-// projectile). advance() reads as the step does: a short table of contents.
+// stiffness schedule; a scene adds its own (the landing's active zone, the
+// sampler's second projectile, the plume's erosion planes, the incline's tilt
+// and glue). advance() reads as the step does: a short table of contents.
 // Measures may take grains out of the run (grains that left the scene): the
 // run removes them after the step, keeping every other contact's springs, and
 // renumbers the groups and every fix's and measure's data. A numerical blow-up
@@ -162,7 +163,7 @@ class Run {
   bool started_ = false, in_stage_ = false, ended_ = false, finished_ = false;
   size_t k_ = 0;                      // current stage
   double t_stage_end_ = 0, next_sample_ = 0, next_check_ = 0;
-  double t_start_ = 0;
+  double t_start_ = 0, stage_t0_ = 0;  // simulated time at the run's and at the stage's start
   long step0_ = 0;
   long rebuilds0_ = 0, body_rebuilds0_ = 0;
   double awake0_ = 0;  // SleepState::awake_grain_steps at the start
@@ -171,7 +172,7 @@ class Run {
   StageReport sr_;
   EnergyWatch energy_watch_;
   bool energy_input_ = false;  // energy was put in since the last check (field, wrench, a fix)
-  std::chrono::steady_clock::time_point t0_, last_progress_;
+  std::chrono::steady_clock::time_point t0_, last_progress_, stage_wall0_;
 };
 
 // RMS and largest speed of the free grains not flagged in `skip`.

@@ -1,4 +1,5 @@
 // The inclined-plane scene kind (see incline_scene.hpp; docs/scenes.md C.2).
+#include "regolith_twin/core/hold.hpp"
 #include "regolith_twin/scenes/incline/incline_scene.hpp"
 #include "regolith_twin/core/types.hpp"
 
@@ -120,8 +121,8 @@ void InclineFix::after_step(const Stage&, Model& m, State& s) {
   // Every free grain that touches the plane is glued where it is (docs/scenes.md C.2).
   bool glued = false;
   for (int i = 0; i < m.n_grains; ++i)
-    if (m.grain_inv_mass[i] != 0 && s.pos[i].z() - m.grain_radius[i] < floor_) {
-      hold_grain(m, s, i);
+    if (!held(m, i) && s.pos[i].z() - m.grain_radius[i] < floor_) {
+      hold_grain(m, s, i, kHoldGlued);
       glued = true;
     }
   if (glued) s.rebuild_requested = true;  // pair constants (m*) and partitions follow
@@ -146,7 +147,7 @@ double InclineObserver::mean_vx(const Model& m, const State& s) const {
   double v = 0;
   long n = 0;
   for (int i = 0; i < m.n_grains; ++i)
-    if (m.grain_inv_mass[i] != 0) {
+    if (!held(m, i)) {
       v += s.vel[i].x();
       ++n;
     }
@@ -187,7 +188,7 @@ bool InclineObserver::after_step(const Model& m, const State& s) {
     win_v_.push_back(mean_vx(m, s));
   }
   for (int i = 0; i < m.n_grains; ++i) {
-    if (m.grain_inv_mass[i] == 0) continue;
+    if (held(m, i)) continue;
     const int k = int(std::floor((s.pos[i].z() - base_) / sp_.layer));
     if (k < 0 || k >= int(sum_vx_.size())) continue;
     const double r = m.grain_radius[i];
@@ -203,7 +204,7 @@ bool InclineObserver::at_rest_check(const Model& m, const State& s) {
   const double limit = sp_.rest_speed * std::sqrt(g_ * d_);
   double v2 = 0;
   for (int i = 0; i < m.n_grains; ++i)
-    if (m.grain_inv_mass[i] != 0) v2 = std::max(v2, s.vel[i].squaredNorm());
+    if (!held(m, i)) v2 = std::max(v2, s.vel[i].squaredNorm());
   if (!(v2 < limit * limit)) {
     rest_t_.clear();
     rest_v_.clear();
@@ -223,7 +224,7 @@ void InclineObserver::find_layers(const Model& m, const State& s) {
   double base = floor_;
   std::vector<double> tops;
   for (int i = 0; i < m.n_grains; ++i) {
-    if (m.grain_inv_mass[i] == 0) base = std::max(base, s.pos[i].z() + m.grain_radius[i]);
+    if (held(m, i)) base = std::max(base, s.pos[i].z() + m.grain_radius[i]);
     else tops.push_back(s.pos[i].z() + m.grain_radius[i]);
   }
   std::sort(tops.begin(), tops.end(), std::greater<double>());
@@ -241,7 +242,7 @@ void InclineObserver::find_layers(const Model& m, const State& s) {
 void InclineObserver::finish(const Model& m, const State& s) {
   if (sp_.rain) {  // the rain scene starts without glued grains (InclineFix glues them)
     glued_ = 0;
-    for (int i = 0; i < m.n_grains; ++i) glued_ += m.grain_inv_mass[i] == 0;
+    for (int i = 0; i < m.n_grains; ++i) glued_ += held(m, i);
   }
   if (sp_.rain && rested_) {
     // Every free grain at rest for rest_hold s: not flowing; the end state is read over that hold.
@@ -409,7 +410,7 @@ std::unique_ptr<Scene> InclineKind::prepare(const YAML::Node& doc, const std::st
       }
     if (!floor) rd.fail("walls", "mode rain needs a plane floor (normal +z) to glue the first grains to");
     for (int i = 0; i < m.n_grains; ++i)
-      if (m.grain_fixed[i]) rd.fail("grains", "mode rain forms its own base: no glued ('fixed') grains");
+      if (held(m, i)) rd.fail("grains", "mode rain forms its own base: no glued ('fixed') grains");
     State s = sc.initial;
     double d = 0;
     for (int i = 0; i < m.n_grains; ++i) d += 2 * m.grain_radius[i];
@@ -436,7 +437,7 @@ std::unique_ptr<Scene> InclineKind::prepare(const YAML::Node& doc, const std::st
   std::vector<double> tops;
   for (int i = 0; i < m.n_grains; ++i) {
     const double r = m.grain_radius[i];
-    if (m.grain_fixed[i]) {
+    if (held(m, i)) {
       base = std::max(base, s.pos[i].z() + r);
       ++is->base_grains;
       continue;

@@ -202,8 +202,27 @@ std::vector<Vec3> lander_corners(const Model& m, const State& s, int b) { return
 
 LandingTracker::LandingTracker(const BodyModel& bm, const LandingSpec& sp, const Vec3& gravity, double t_start)
     : bm_(bm), sp_(sp), g_(gravity), t_start_(t_start) {
-  if (const int k = largest_box(bm); k >= 0)
+  if (const int k = largest_box(bm); k >= 0) {
     liftoff_com_ = std::max(0.0, bm.shapes[k].size.minCoeff() - bm.shapes[k].pos.norm());
+    reach_ = bm.shapes[k].size.norm() + bm.shapes[k].pos.norm();
+  }
+}
+
+double LandingTracker::expected_time_left(double t, const BodyState& bs) const {
+  if (ended()) return 0;
+  if (o_.lifted_off_clear) return std::max(0.0, o_.t_liftoff_clear + sp_.after_liftoff - t);
+  const double low = lowest_corner(bs), vn = bs.vel.z();
+  // Approach: to first contact at the present speed, then the collision as if it began now.
+  const double v_ref = o_.contact ? vn_in_ : -vn;
+  if (!(v_ref > 0) || reach_ <= 0) return -1;
+  const double to_contact = o_.contact ? 0.0 : std::max(low, 0.0) / v_ref;
+  // While the lander still sinks its centre will end lower: the worst attitude weighs more.
+  const double worst = o_.contact && vn >= 0 ? kWorstShare : kWorstShareSinking;
+  const double rise = (1 - worst) * std::max(-low, 0.0) + worst * std::max(sp_.rim + reach_ - bs.pos.z(), 0.0);
+  const double up = std::max(o_.contact ? vn : 0.0, kReboundFraction * v_ref);
+  double left = to_contact + rise / up + sp_.after_liftoff;
+  if (o_.contact) left = std::min(left, o_.t_contact + sp_.max_after_contact - t);
+  return std::max(left, 0.0);
 }
 
 double LandingTracker::lowest_corner(const BodyState& bs) const {
@@ -254,6 +273,7 @@ bool LandingTracker::update(double t, const BodyState& bs, const BodyContacts& c
     o_.contact = true;
     o_.t_contact = t;
     o_.v_in = bs.vel.norm();
+    vn_in_ = std::max(0.0, -bs.vel.z());
     o_.e_lin_in = body_lin_energy(bm_, bs);
     o_.e_rot_in = body_rot_energy(bm_, bs);
   }
@@ -405,6 +425,10 @@ double LandingTrackerObserver::time_left(const State& s) const {
   if (!o.contact) return -1;
   return (!o.lifted_off_clear ? o.t_contact + sp_.max_after_contact : o.t_liftoff_clear + sp_.after_liftoff) -
          s.time;
+}
+
+double LandingTrackerObserver::expected_time_left(const State& s) const {
+  return tracker_->expected_time_left(s.time, s.bodies[b_]);
 }
 
 LandingOutcome run_landing(Model& m, State& s, int b, const LandingSpec& sp, const LandingOptions& opt) {

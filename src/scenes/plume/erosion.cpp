@@ -1,4 +1,5 @@
 // Plume erosion measurement (see erosion.hpp; docs/scenes.md D).
+#include "regolith_twin/core/hold.hpp"
 #include "regolith_twin/scenes/plume/erosion.hpp"
 
 #include <algorithm>
@@ -19,9 +20,6 @@ void ErosionFix::prepare(Model& m, State& s) {
   s.field_values[p_.erosion_slot] = p_.erosion;
   n_grains_ = m.n_grains;
   if (p_.hold_below_anchor) {
-    inv_mass_ = m.grain_inv_mass;
-    inv_inertia_ = m.grain_inv_inertia;
-    held_.assign(m.n_grains, 0);
     hold(m, s, true);
   }
 }
@@ -31,15 +29,13 @@ void ErosionFix::hold(Model& m, State& s, bool first) {
   const double a = s.field_values[p_.anchor_slot];
   bool changed = false;
   for (int i = 0; i < m.n_grains; ++i) {
-    if (inv_mass_[i] == 0) continue;  // glued from the start: stays glued
-    const bool below = s.pos[i].z() <= a;
-    if (below && !held_[i]) {
-      held_[i] = 1;
-      hold_grain(m, s, i);
+    if (m.grain_hold[i] & kHoldGlued) continue;  // glued by the scene: stays glued
+    const bool below = s.pos[i].z() <= a, anchored = m.grain_hold[i] & kHoldAnchored;
+    if (below && !anchored) {
+      hold_grain(m, s, i, kHoldAnchored);
       changed = true;
-    } else if (!below && held_[i]) {
-      held_[i] = 0;
-      free_grain(m, i, inv_mass_[i], inv_inertia_[i]);
+    } else if (!below && anchored) {
+      release_grain(m, i, kHoldAnchored);
       changed = true;
     }
   }
@@ -192,11 +188,7 @@ void ErosionFix::finish(Model& m, State& s) {
   rate_ = n > 1 && den > 0 ? (n * sxy - sx * sy) / den : 0;
   rate_intercept_ = n > 0 ? (sy - rate_ * sx) / n : 0;
   if (p_.hold_below_anchor) {  // the model's masses back as they were
-    for (int i = 0; i < m.n_grains && i < int(held_.size()); ++i)
-      if (held_[i]) {
-        free_grain(m, i, inv_mass_[i], inv_inertia_[i]);
-        held_[i] = 0;
-      }
+    for (int i = 0; i < m.n_grains; ++i) release_grain(m, i, kHoldAnchored);
     s.rebuild_requested = true;
     s.forces_valid = false;
   }

@@ -1,6 +1,7 @@
 // Gas against weight, and the eroded grains' upward impulses (see
 // gas_budget.hpp; docs/scenes.md D).
 #include "regolith_twin/scenes/plume/gas_budget.hpp"
+#include "regolith_twin/core/hold.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -73,7 +74,7 @@ void ImpulseObserver::start(const Model& m, const State& s) {
   for (int i = 0; i < n; ++i) floor_ = std::min(floor_, s.pos[i].z() - m.grain_radius[i]);
   for (int i = 0; i < n; ++i) {
     // prime() evaluates the fields at v(n).
-    if (m.grain_inv_mass[i] != 0) gas_prev_[i] = gas_on(m, s, i, s.vel[i], anchor);
+    if (!held(m, i)) gas_prev_[i] = gas_on(m, s, i, s.vel[i], anchor);
     v_start_[i] = asc_v_start_[i] = s.vel[i].z();
     tracking_[i] = s.pos[i].z() > erosion - below_;
     above_[i] = s.pos[i].z() > erosion;
@@ -199,7 +200,7 @@ void ImpulseObserver::row(const Model& m, const State& s, std::vector<double>& o
       floor += vx;
       ++nf;
     }
-    if (z <= surface && z > surface - 2 * m.grain_radius[i] && m.grain_inv_mass[i] != 0 && m.gravity.z() != 0) {
+    if (z <= surface && z > surface - 2 * m.grain_radius[i] && !held(m, i) && m.gravity.z() != 0) {
       const double l = -gas_prev_[i].z() * m.grain_inv_mass[i] / m.gravity.z();
       lift += l;
       lift_max = std::max(lift_max, l);

@@ -1,6 +1,7 @@
 // Crater depth and radius, and the packing below the filter (see crater.hpp,
 // packing_below_filter.hpp; docs/scenes.md B.3).
 #include "regolith_twin/scenes/sampler/crater.hpp"
+#include "regolith_twin/core/hold.hpp"
 #include "regolith_twin/core/types.hpp"
 
 #include <algorithm>
@@ -71,7 +72,7 @@ void Crater::profiles(const Model& m, const State& s, std::vector<double>& col, 
   ring.assign(nr, 0.0);
   const double top = impact_.z(), ring_lo = top - ring_depth_;
   for (int i = 0; i < m.n_grains; ++i) {
-    if (not_bed_(i) || m.grain_inv_mass[i] == 0) continue;
+    if (not_bed_(i) || held(m, i)) continue;
     const Vec3& p = s.pos[i];
     const double r = m.grain_radius[i];
     if (p.z() - r >= top || p.z() + r <= top - max_depth_) continue;
@@ -151,7 +152,7 @@ std::vector<double> PackingBelowFilter::profile(const Model& m, const State& s) 
   std::vector<double> v(n_, 0.0);
   const double fb = g_.filter_bottom, lo = fb - n_ * slice_;
   for (int i = 0; i < m.n_grains; ++i) {
-    if (m.grain_inv_mass[i] == 0) continue;
+    if (held(m, i)) continue;
     const double z = g_.axial(s.pos[i]), r = m.grain_radius[i];
     if (z + r <= lo || z - r >= fb) continue;
     const Vec3 ph = Vec3(s.pos[i].x() - g_.origin.x(), s.pos[i].y() - g_.origin.y(), z);

@@ -1,5 +1,6 @@
 // Grains in the sampler horn (see horn_segments.hpp).
 #include "regolith_twin/scenes/sampler/horn_segments.hpp"
+#include "regolith_twin/core/hold.hpp"
 
 #include <cstdio>
 
@@ -14,7 +15,7 @@ void HornSegments::count(const Model& m, const State& s) {
   c_.top_count = top_count;
   c_.top_mass = top_mass;
   for (int i = 0; i < m.n_grains; ++i) {
-    if (not_bed_(i) || m.grain_inv_mass[i] == 0) continue;
+    if (not_bed_(i) || held(m, i)) continue;
     const int k = g_.segment_of(s.pos[i]);
     if (k < 0) continue;
     ++c_.count[k];
@@ -28,7 +29,7 @@ bool HornSegments::leaving(const Model& m, const State& s, std::vector<uint8_t>&
   bool any = false;
   const double top = g_.top(), rt = g_.top_radius();
   for (int i = 0; i < m.n_grains; ++i) {
-    if (not_bed_(i) || m.grain_inv_mass[i] == 0 || drop[i]) continue;
+    if (not_bed_(i) || held(m, i) || drop[i]) continue;
     if (g_.axial(s.pos[i]) <= top || g_.radial(s.pos[i]) >= rt + m.grain_radius[i]) continue;
     drop[i] = 1;
     any = true;

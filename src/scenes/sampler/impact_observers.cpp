@@ -1,5 +1,6 @@
 // Measurements around the sampler projectile's impact (docs/scenes.md B.4).
 #include "regolith_twin/scenes/sampler/impact_observers.hpp"
+#include "regolith_twin/core/hold.hpp"
 #include "regolith_twin/core/types.hpp"
 
 #include <algorithm>
@@ -38,7 +39,7 @@ double rms_speed(const Model& m, const State& s, int skip) {
   double sum = 0;
   long n = 0;
   for (int i = 0; i < m.n_grains; ++i) {
-    if (i == skip || m.grain_inv_mass[i] == 0) continue;
+    if (i == skip || held(m, i)) continue;
     sum += s.vel[i].squaredNorm();
     ++n;
   }
@@ -225,7 +226,7 @@ EnergyParts energy_parts(const Model& m, const State& s, int projectile) {
   EnergyParts e;
   e.t = s.time;
   for (int i = 0; i < m.n_grains; ++i) {
-    if (m.grain_inv_mass[i] == 0) continue;
+    if (held(m, i)) continue;
     const double trans = 0.5 * m.grain_mass[i] * s.vel[i].squaredNorm();
     const double rot = 0.5 * (1.0 / m.grain_inv_inertia[i]) * s.omega[i].squaredNorm();
     if (i == projectile) {

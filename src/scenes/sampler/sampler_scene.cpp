@@ -1,5 +1,6 @@
 // The sampler scene kind (see sampler_scene.hpp; docs/scenes.md B).
 #include "regolith_twin/scenes/sampler/sampler_scene.hpp"
+#include "regolith_twin/core/hold.hpp"
 #include "regolith_twin/core/types.hpp"
 
 #include <yaml-cpp/yaml.h>

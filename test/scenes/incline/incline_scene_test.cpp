@@ -63,6 +63,7 @@ TEST(InclineOnset, AStepThroughAnglesSkipsADyingSurgeAndStopsAtSustainedFlow) {
   rt::Model m;
   m.n_grains = 2;
   m.grain_inv_mass = {1.0, 1.0};
+  m.grain_hold = {0, 0};
   m.dt = 1e-3;
   rt::State s;
   s.pos.assign(2, rt::Vec3::Zero());
@@ -180,8 +181,8 @@ TEST(InclineRain, GrainsThatTouchThePlaneAreGluedWhereTheyLand) {
   EXPECT_NEAR(m.gravity.x(), 9.81 * std::sin(20 * kPi / 180), 1e-12);
   int glued = 0;
   for (int i = 0; i < m.n_grains; ++i) {
-    EXPECT_FALSE(sc->sc.model.grain_fixed[i]);
-    if (!m.grain_fixed[i]) {
+    EXPECT_FALSE(sc->sc.model.grain_hold[i]);
+    if (!m.grain_hold[i]) {
       EXPECT_GE(s.pos[i].z() - m.grain_radius[i], -1e-3) << "a free grain sank into the plane";
       continue;
     }

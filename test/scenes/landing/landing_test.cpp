@@ -232,3 +232,52 @@ TEST(Landing, LanderTrappedBelowTheTrimPlaneEndsTheRunEarly) {
     }
   }
 }
+
+TEST(Landing, TheExpectedTimeLeftIsExactInFlightAndWithinTwiceOnAStraightRise) {
+  // The tracker fed by hand: first contact at 0.1 m/s downwards, then the
+  // lander (tilted 20 and 10 degrees, as a corner-first attitude) rising at
+  // 0.02 m/s from 6 cm under the trim plane without turning, and no contact,
+  // until the run ends 1 s after the clear lift-off. Before it the estimate
+  // must lie within a factor of 2 of the time then left while the lowest
+  // corner is at least 1 cm under (the promise of the progress line); in
+  // flight it is exact; and it never exceeds the bound of max_after_contact.
+  const double rim = 0.3, v = 0.02, dt = 0.01;
+  const rt::Model m = lander_scene(rim, 0.6);
+  rt::LandingSpec sp = plate_spec(rim, 0, 0.1);
+  sp.g = 0;
+  sp.after_liftoff = 1.0;
+  sp.max_after_contact = 60;
+  rt::LandingTracker tr(m.bodies[0], sp, Vec3::Zero());
+  rt::BodyState bs;
+  bs.q = rt::Quat(Eigen::AngleAxisd(20 * kPi / 180, Vec3::UnitY()) * Eigen::AngleAxisd(10 * kPi / 180, Vec3::UnitX()));
+  bs.pos = Vec3(0, 0, rim);
+  bs.pos.z() += -0.06 - tr.lowest_corner(bs);  // lowest corner 6 cm under the plane
+  bs.vel = Vec3(0, 0, -0.1);
+  rt::BodyContacts touch;
+  touch.total = touch.bed = 1;
+  ASSERT_FALSE(tr.update(0, bs, touch));
+  const double t_end = 0.06 / v + sp.after_liftoff;  // the clear lift-off, then 1 s
+  bs.vel = Vec3(0, 0, v);
+  std::vector<double> ratios;
+  double t = 0;
+  for (int k = 1; !tr.ended(); ++k) {
+    t = k * dt;
+    bs.pos.z() += v * dt;
+    ASSERT_FALSE(tr.update(t, bs, rt::BodyContacts()) && t < t_end - 2 * dt) << "ended early at " << t;
+    if (tr.ended()) break;
+    const double e = tr.expected_time_left(t, bs), left = t_end - t;
+    ASSERT_GE(e, 0) << t;
+    EXPECT_LE(e, 60 - t) << t;
+    if (tr.outcome().lifted_off_clear) {
+      EXPECT_NEAR(e, tr.outcome().t_liftoff_clear + sp.after_liftoff - t, 1e-12) << t;
+    } else if (tr.lowest_corner(bs) < -0.01) {
+      ratios.push_back(e / left);
+    }
+  }
+  ASSERT_GT(ratios.size(), 100u);
+  for (double q : ratios) {
+    EXPECT_GT(q, 0.5);
+    EXPECT_LT(q, 2.0);
+  }
+  EXPECT_NEAR(t, t_end, 2 * dt) << "the run's end";
+}

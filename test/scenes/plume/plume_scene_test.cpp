@@ -10,6 +10,7 @@
 
 #include <cmath>
 
+#include "regolith_twin/core/hold.hpp"
 #include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/core/field.hpp"
 #include "regolith_twin/core/step.hpp"
@@ -130,13 +131,12 @@ TEST(MobileContacts, FreeGrainsPassThroughEachOtherButTouchGluedOnes) {
   EXPECT_EQ(f.s.pairs.size(), 0);
   EXPECT_EQ(f.s.vel[0], Vec3::Zero());
   EXPECT_EQ(f.s.vel[1], Vec3::Zero());
-  const double inv_mass = f.m.grain_inv_mass[0], inv_inertia = f.m.grain_inv_inertia[0];
-  rt::hold_grain(f.m, f.s, 0);  // ... but touch a glued one
+  rt::hold_grain(f.m, f.s, 0, rt::kHoldGlued);  // ... but touch a glued one
   f.s.rebuild_requested = true;
   rt::step(f.m, f.s);
   EXPECT_GT(f.s.vel[1].x(), 0);
   EXPECT_EQ(f.s.vel[0], Vec3::Zero());
-  rt::free_grain(f.m, 0, inv_mass, inv_inertia);
+  rt::release_grain(f.m, 0, rt::kHoldGlued);
   f.s.vel[1] = Vec3::Zero();
   f.m.mobile_contacts = true;  // the same overlap pushes both apart
   f.s.rebuild_requested = true;

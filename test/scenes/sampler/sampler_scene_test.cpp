@@ -219,6 +219,7 @@ TEST(HornSegments, GrainsLeavingThroughTheTopAreCollected) {
   m.n_grains = int(pos.size());
   m.grain_radius.assign(pos.size(), r);
   m.grain_inv_mass.assign(pos.size(), 1 / mass);
+  m.grain_hold.assign(pos.size(), 0);
   m.grain_material.assign(pos.size(), 0);
   for (Vec3& p : pos) p += g.origin;
   s.pos = pos;
@@ -300,6 +301,7 @@ TEST(Crater, DepthAndRadiusOfAHemisphericalHole) {
   m.n_grains = int(pos.size());
   m.grain_radius.assign(pos.size(), r);
   m.grain_inv_mass.assign(pos.size(), 1.0);
+  m.grain_hold.assign(pos.size(), 0);
   s.pos = pos;
   rt::Crater c(Vec3::Zero(), -1, 1, 0.5, 0.01, 1e-3, 0.03, 0.01, 0.028);
   c.start(m, s);

@@ -163,6 +163,18 @@ class LandingTracker {
   const LandingOutcome& outcome() const { return o_; }
   const char* phase() const;  // approach | collision | flight
   double lowest_corner(const BodyState& bs) const;  // lowest corner above the trim plane, m
+  // Simulated time left to the run end as expected from the lander's state
+  // at time t (an estimate for the progress line, not a figure; < 0: none).
+  // In flight it is exact. Before the clear lift-off the centre of mass must
+  // still rise by a share between the lowest corner's depth below the trim
+  // plane (the attitude kept) and the depth of the plane below the centre
+  // plus the corners' reach (the worst attitude: kWorstShare of it once the
+  // lander rises, kWorstShareSinking while it still sinks or approaches), at
+  // its rising speed but not below kReboundFraction of its normal speed at
+  // first contact; then after_liftoff. The constants were chosen on recorded
+  // landings; docs/scenes.md A.9 gives the measured accuracy.
+  double expected_time_left(double t, const BodyState& bs) const;
+  static constexpr double kReboundFraction = 0.08, kWorstShare = 0.4, kWorstShareSinking = 0.7;
 
  private:
   bool trapped(double t, const BodyState& bs);
@@ -173,6 +185,8 @@ class LandingTracker {
   double t_start_ = 0;
   double liftoff_com_ = 0;      // lowest centre-of-mass height above the plane with every corner above it
   double trapped_since_ = -1;
+  double reach_ = 0;            // largest distance of a corner from the centre of mass, m
+  double vn_in_ = 0;            // normal speed into the plane at first contact, m/s
   bool went_under_ = false;     // a corner has been below the trim plane since first contact
   LandingOutcome o_;
 };
@@ -191,6 +205,7 @@ class LandingTrackerObserver : public Observer {
   void finish(const Model& m, const State& s) override;
   std::string progress(const Model& m, const State& s) const override;
   double time_left(const State& s) const override;
+  double expected_time_left(const State& s) const override;
 
   const LandingTracker& tracker() const { return *tracker_; }
   double max_overlap_ratio() const { return max_overlap_; }

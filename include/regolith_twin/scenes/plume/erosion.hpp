@@ -84,8 +84,7 @@ class ErosionFix : public Fix {
   void count(const Model& m, const State& s, int& pairs, int& touching) const;
   void hold(Model& m, State& s, bool first);
   ErosionPlanes p_;
-  std::vector<uint8_t> is_above_, held_;
-  std::vector<double> inv_mass_, inv_inertia_;
+  std::vector<uint8_t> is_above_;
   mutable std::vector<uint8_t> touched_;  // count()'s scratch, sized once
   // Least-squares sums of N(t) up to depletion (t from the start).
   double t0_ = 0, fit_sx_ = 0, fit_sy_ = 0, fit_sxx_ = 0, fit_sxy_ = 0;

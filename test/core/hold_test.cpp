@@ -17,19 +17,10 @@ struct Two {
   rt::State s;
 };
 
-// Two grains of 0.5 mm radius, 0.1 mm apart along x, no gravity.
+// Two grains of 0.5 and 0.4 mm radius, centres 1 mm apart along x, no gravity.
 Two two() {
   Two t;
-  t.m.materials.push_back(rt::test::simple_material("grain", 2700, 0.8, 0.8, 0.2));
-  t.m.gravity = Vec3::Zero();
-  rt::add_grain(t.m, 5e-4, 0);
-  rt::add_grain(t.m, 4e-4, 0);
-  t.m.kn = 8000;
-  t.m.dt = 1e-6;
-  rt::finalize_model(t.m);
-  t.s = rt::make_state(t.m);
-  t.s.pos[0] = Vec3(0, 0, 0.001);
-  t.s.pos[1] = Vec3(0.001, 0, 0.001);
+  rt::test::grains_in_a_row(t.m, t.s, {5e-4, 4e-4}, 0.001);
   return t;
 }
 

@@ -54,6 +54,17 @@ Material simple_material(const std::string& name, double density, double eps_n, 
   return m;
 }
 
+void grains_in_a_row(Model& m, State& s, const std::vector<double>& radii, double spacing) {
+  m.materials.push_back(simple_material("grain", 2700, 0.8, 0.8, 0.2));
+  m.gravity = Vec3::Zero();
+  for (double r : radii) add_grain(m, r, 0);
+  m.kn = 8000;
+  m.dt = 1e-6;
+  finalize_model(m);
+  s = make_state(m);
+  for (size_t i = 0; i < radii.size(); ++i) s.pos[i] = Vec3(spacing * double(i), 0, 0.001);
+}
+
 void grain_and_wall_in_open_box(Model& m, double side) {
   m.materials = {simple_material("grain", 2430, 0.5, 0.5, 0.5), simple_material("wall", 2430, 0.5, 0.5, 0.5)};
   m.materials[1].structure = true;

@@ -3,6 +3,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "regolith_twin/core/body.hpp"
 #include "regolith_twin/core/energy.hpp"
@@ -19,6 +20,11 @@ std::string figure(double v);
 
 // A material with the given restitution and friction (no rolling/twisting).
 Material simple_material(const std::string& name, double density, double eps_n, double eps_t, double mu_s);
+
+// Free grains of the given radii in a row along x at z = 1 mm, `spacing`
+// apart (centres), of one material `grain` (2700 kg/m^3, ε 0.8, μ 0.2), no
+// gravity, k_n = 8000 N/m, Δt = 1 µs: a model (finalized) and its state.
+void grains_in_a_row(Model& m, State& s, const std::vector<double>& radii, double spacing);
 
 // Materials `grain` (0) and `wall` (1, a structure), both density 2430,
 // ε_n = ε_t = μ = 0.5, and an open box: a floor at z = 0 and side planes at

@@ -32,14 +32,7 @@ struct Four {
 
 Four four() {
   Four f;
-  f.m.materials.push_back(rt::test::simple_material("grain", 2700, 0.8, 0.8, 0.2));
-  f.m.gravity = Vec3::Zero();
-  for (int i = 0; i < 4; ++i) rt::add_grain(f.m, 5e-4, 0);
-  f.m.kn = 8000;
-  f.m.dt = 1e-6;
-  rt::finalize_model(f.m);
-  f.s = rt::make_state(f.m);
-  for (int i = 0; i < 4; ++i) f.s.pos[i] = Vec3(0.01 * i, 0, 0.001);
+  rt::test::grains_in_a_row(f.m, f.s, std::vector<double>(4, 5e-4), 0.01);
   return f;
 }
 

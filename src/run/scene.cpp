@@ -7,7 +7,6 @@
 #include <limits>
 #include <mutex>
 
-#include "regolith_twin/scenes/registry.hpp"
 #include "regolith_twin/run/scenario_kind.hpp"
 
 namespace rt {

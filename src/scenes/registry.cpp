@@ -1,5 +1,5 @@
 // The built-in scene kinds: a new kind is a folder under src/scenes and a line here.
-#include "regolith_twin/scenes/registry.hpp"
+#include "regolith_twin/run/scene.hpp"
 
 #include "regolith_twin/scenes/impact/impact_scene.hpp"
 #include "regolith_twin/scenes/incline/incline_scene.hpp"

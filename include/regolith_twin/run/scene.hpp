@@ -105,9 +105,15 @@ class SceneKind {
                                          const SceneOptions& opt) const = 0;
 };
 
-// The registry: the built-in kinds (src/scenes/registry.cpp) and any added at
-// run time (tests add their own).
+// The registry: the built-in kinds and any added at run time (tests add
+// their own).
 void register_scene_kind(std::shared_ptr<const SceneKind> kind);
+
+// The kinds the package is built with. Declared here, for the registry,
+// and defined one layer up, by the kinds themselves: one line each in
+// src/scenes/registry.cpp (their ROS topics: src/ros/scenes/registry.cpp).
+// The run layer names no kind, so no include points up a layer.
+std::vector<std::shared_ptr<const SceneKind>> builtin_scene_kinds();
 std::vector<std::string> scene_kind_names();
 
 // The kind a document asks for: the registered kind whose block it has, the

@@ -85,7 +85,7 @@ bool Run::ended() { return !settle(); }
 void Run::start() {
   started_ = true;
   t0_ = last_progress_ = Clock::now();
-  t_start_ = s_.time;
+  t_start_ = rate_t_ = s_.time;
   step0_ = s_.step;
   rebuilds0_ = s_.rebuilds;
   body_rebuilds0_ = s_.body_rebuilds;
@@ -136,7 +136,7 @@ void Run::begin_stage() {
   for (Fix* f : fixes_) f->stage_start(st, m_, s_, sr_);
   t_stage_end_ = s_.time + st.duration;
   stage_t0_ = s_.time;
-  stage_wall0_ = Clock::now();
+  rate_ = -1;
   next_check_ = s_.time + st.check_every;
   in_stage_ = true;
 }
@@ -251,16 +251,20 @@ void Run::sample() {
 
 void Run::progress() {
   const auto now = Clock::now();
-  if (std::chrono::duration<double>(now - last_progress_).count() < opt_.progress_every) return;
+  const double since = std::chrono::duration<double>(now - last_progress_).count();
+  if (since < opt_.progress_every) return;
   last_progress_ = now;
   const double wall = std::chrono::duration<double>(now - t0_).count();
   const double steps_s = double(s_.step - step0_) / std::max(wall, 1e-9);
-  // Simulated seconds per wall second: of this stage once it has run a while
-  // (stages differ in cost: a relaxation beside a landing), else of the run.
-  const double stage_wall = std::chrono::duration<double>(now - stage_wall0_).count();
-  const double rate = stage_wall >= 2 * opt_.progress_every
-                          ? (s_.time - stage_t0_) / stage_wall
-                          : (s_.time - t_start_) / std::max(wall, 1e-9);
+  // Simulated seconds per wall second, averaged over about the last minute
+  // (kRateWindow): it follows the load of the machine and the run's own
+  // phases; it starts afresh with each stage (a relaxation and a landing
+  // differ in cost), from the run's average.
+  const double rate_now = (s_.time - rate_t_) / std::max(since, 1e-9);
+  rate_t_ = s_.time;
+  if (rate_ < 0) rate_ = (s_.time - t_start_) / std::max(wall, 1e-9);
+  else rate_ += (1 - std::exp(-since / kRateWindow)) * (rate_now - rate_);
+  const double rate = rate_;
   // Time left: the rest of the stages with a duration, or what the measures
   // expect (an estimate) or know as a bound.
   double left = 0, total = s_.time;

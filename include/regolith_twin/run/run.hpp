@@ -164,6 +164,10 @@ class Run {
   size_t k_ = 0;                      // current stage
   double t_stage_end_ = 0, next_sample_ = 0, next_check_ = 0;
   double t_start_ = 0, stage_t0_ = 0;  // simulated time at the run's and at the stage's start
+  // The progress line's rate (simulated s per wall s; < 0: not yet measured in this stage), its
+  // window (wall s) and the simulated time of the last progress line.
+  double rate_ = -1, rate_t_ = 0;
+  static constexpr double kRateWindow = 60;
   long step0_ = 0;
   long rebuilds0_ = 0, body_rebuilds0_ = 0;
   double awake0_ = 0;  // SleepState::awake_grain_steps at the start
@@ -172,7 +176,7 @@ class Run {
   StageReport sr_;
   EnergyWatch energy_watch_;
   bool energy_input_ = false;  // energy was put in since the last check (field, wrench, a fix)
-  std::chrono::steady_clock::time_point t0_, last_progress_, stage_wall0_;
+  std::chrono::steady_clock::time_point t0_, last_progress_;
 };
 
 // RMS and largest speed of the free grains not flagged in `skip`.

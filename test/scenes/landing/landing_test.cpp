@@ -263,8 +263,7 @@ TEST(Landing, TheExpectedTimeLeftIsExactInFlightAndWithinTwiceOnAStraightRise) {
   for (int k = 1; !tr.ended(); ++k) {
     t = k * dt;
     bs.pos.z() += v * dt;
-    ASSERT_FALSE(tr.update(t, bs, rt::BodyContacts()) && t < t_end - 2 * dt) << "ended early at " << t;
-    if (tr.ended()) break;
+    if (tr.update(t, bs, rt::BodyContacts())) break;  // the run's end: checked after the loop
     const double e = tr.expected_time_left(t, bs), left = t_end - t;
     ASSERT_GE(e, 0) << t;
     EXPECT_LE(e, 60 - t) << t;

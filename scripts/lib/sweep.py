@@ -141,18 +141,41 @@ def hold_folder(out):
 
 
 def read_json(path):
+    """The JSON object in PATH; None when it is missing, unreadable, or not an
+    object (a file of the right name and the wrong shape is not a run's)."""
     try:
         with open(path) as f:
-            return json.load(f)
-    except (OSError, ValueError):
+            v = json.load(f)
+    except (OSError, ValueError, RecursionError):
         return None
+    return v if isinstance(v, dict) else None
+
+
+def obj(x):
+    """x when it is a JSON object, else an empty one (a summary's block of the wrong shape)."""
+    return x if isinstance(x, dict) else {}
+
+
+def meta_problem(meta):
+    """'' when a run's sweep_run.json names its grid point with values of the right types, else what is wrong."""
+    for k, types in (("material", str), ("depth", (int, float)), ("attitude", str), ("angle", (int, float)),
+                     ("repeat", int)):
+        v = meta.get(k)
+        if isinstance(v, bool) or not isinstance(v, types):
+            return f"'{k}' is {json.dumps(v)[:40]}"
+    return ""
+
+
+def warn(msg):
+    print(f"sweep: warning: {msg}", file=sys.stderr, flush=True)
 
 
 def is_done(run_dir):
     """A finished run: summary.json with status ok, from a regolith_land that exited 0."""
     s = read_json(os.path.join(run_dir, "summary.json"))
     meta = read_json(os.path.join(run_dir, "sweep_run.json"))
-    return bool(s) and s.get("status") == "ok" and bool(meta) and meta.get("exit_code") == 0
+    return bool(s) and s.get("status") == "ok" and bool(meta) and meta.get("exit_code") == 0 \
+        and not meta_problem(meta)
 
 
 def to_portable(x):
@@ -193,8 +216,17 @@ def restore_records(a, grid):
     for p in grid:
         name = run_name(*p)
         d = os.path.join(a.out, "runs", name)
-        rec = read_json(os.path.join(a.record, name + ".json"))
-        if is_done(d) or not rec or "sweep_run" not in rec or "summary" not in rec:
+        path = os.path.join(a.record, name + ".json")
+        if is_done(d) or not os.path.exists(path):
+            continue
+        rec = read_json(path)
+        problem = "not a JSON object" if rec is None else \
+            "'sweep_run' and 'summary' must be JSON objects" if not (isinstance(rec.get("sweep_run"), dict) and
+                                                                    isinstance(rec.get("summary"), dict)) else \
+            meta_problem(rec["sweep_run"])
+        if problem:
+            warn(f"{path} is not a record of a finished run ({problem}): the run is made again, and its record "
+                 "replaces this file when it finishes")
             continue
         rec = from_portable(rec)
         if rec["summary"].get("status") != "ok" or rec["sweep_run"].get("exit_code") != 0:
@@ -496,8 +528,11 @@ def collect(out):
         meta = read_json(os.path.join(d, "sweep_run.json"))
         if meta is None:
             continue
+        if meta_problem(meta):
+            warn(f"{d}/sweep_run.json is not a run's ({meta_problem(meta)}): left out of the report")
+            continue
         summary = read_json(os.path.join(d, "summary.json")) or {}
-        oc = summary.get("outcome", {})
+        oc = obj(summary.get("outcome"))
         row = {"run": name}
         for k in KEYS:
             row[k] = meta.get(k)
@@ -511,11 +546,12 @@ def collect(out):
                 if k not in outcome_keys:
                     outcome_keys.append(k)
         row["ended_by"] = oc.get("ended_by")
-        bed = summary.get("bed", {})
-        row["grains"] = bed.get("grains")
-        row["packing_fraction"] = bed.get("packing_fraction")
-        row["land_wall_seconds"] = summary.get("run", {}).get("wall_seconds")
-        row["wall_seconds"] = meta.get("wall_seconds")
+        bed = obj(summary.get("bed"))
+        num = lambda v: v if isinstance(v, (int, float)) and not isinstance(v, bool) else None
+        row["grains"] = num(bed.get("grains"))
+        row["packing_fraction"] = num(bed.get("packing_fraction"))
+        row["land_wall_seconds"] = num(obj(summary.get("run")).get("wall_seconds"))
+        row["wall_seconds"] = num(meta.get("wall_seconds"))
         rows.append(row)
     rows.sort(key=lambda r: (r["material"], r["depth"], r["attitude"], r["angle"], r["repeat"]))
     return rows, outcome_keys

@@ -133,6 +133,40 @@ class SweepTest(unittest.TestCase):
                                first["summary"]["outcome"]["speed_ratio"], places=12)
         self.assertEqual(len(os.listdir(rec)), 24)
 
+    def test_records_of_the_wrong_shape(self):
+        # Files of a record's or a run's name that do not hold one (a list, a
+        # summary that is a number, a grid point of the wrong types) are named
+        # in a warning and made again, never a traceback.
+        rec = os.path.join(self.dir, "record")
+        os.makedirs(rec)
+        bad = {"moderate_d30_BCF_a30_r0": [1, 2], "moderate_d30_BCF_a30_r1": {"sweep_run": [], "summary": 3},
+               "gravel_d30_Flat_a0_r0": {"sweep_run": {"material": 7, "exit_code": 0}, "summary": {"status": "ok"}},
+               "gravel_d30_Flat_a0_r1": "not json"}
+        for name, v in bad.items():
+            with open(os.path.join(rec, name + ".json"), "w") as f:
+                f.write(v if isinstance(v, str) else json.dumps(v))
+        p = self.sweep("--record", rec, "--no-run-plots")
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        self.assertNotIn("Traceback", p.stderr)
+        for name in bad:
+            if name != "gravel_d30_Flat_a0_r1":  # not JSON at all: no record, nothing to say
+                self.assertIn(name + ".json is not a record of a finished run", p.stderr)
+            with open(os.path.join(rec, name + ".json")) as f:
+                self.assertEqual(json.load(f)["summary"]["status"], "ok")  # replaced by the run's own
+        self.assertIn("0 already done, 24 to run", p.stdout)
+        # A run folder whose sweep_run.json names its point with the wrong types: left out of the report.
+        meta = os.path.join(self.out, "runs", "gravel_d30_Flat_a0_r0", "sweep_run.json")
+        with open(meta) as f:
+            m = json.load(f)
+        m["depth"] = "deep"
+        with open(meta, "w") as f:
+            json.dump(m, f)
+        p = subprocess.run([sys.executable, SWEEP, "--out", self.out, "--report-only", "--no-run-plots"],
+                           capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        self.assertIn("sweep_run.json is not a run's ('depth' is \"deep\")", p.stderr)
+        self.assertEqual(len(self.rows()), 23)
+
     def test_missing_bed(self):
         os.remove(os.path.join(self.beds, "mascot_gravel_d30.bed"))
         p = self.sweep()

@@ -127,17 +127,20 @@ void check_periodic(const Model& m) {
     const double L = p.length[a];
     if (!std::isfinite(p.lo[a]) || !std::isfinite(L) || !(L >= least)) {
       std::ostringstream os;
-      os << "model: the periodic box along " << names[a] << " is " << L << " m long; it must be at least "
+      os << "model: the periodic box along " << names[a] << " (periodic." << names[a] << ") is " << L
+         << " m long; it must be at least "
          << least << " m = 2 (2 r_max + skin), so that a grain meets one image of another at most";
       throw InputError(os.str());
     }
   }
-  for (const Wall& w : m.walls) {
+  for (size_t k = 0; k < m.walls.size(); ++k) {
+    const Wall& w = m.walls[k];
+    const std::string key = "walls[" + std::to_string(k) + "]";
     if (w.type != WallType::Plane)
-      throw InputError("model: wall '" + w.name + "': only plane walls are allowed in a periodic box");
+      throw InputError("model: wall '" + w.name + "' (" + key + ".type): only plane walls are allowed in a periodic box");
     if ((p.x && w.axis.x() != 0) || (p.y && w.axis.y() != 0))
-      throw InputError("model: wall '" + w.name +
-                       "' cuts a periodic direction: its normal must be perpendicular to the periodic axes");
+      throw InputError("model: wall '" + w.name + "' (" + key +
+                       ".normal) cuts a periodic direction: its normal must be perpendicular to the periodic axes");
   }
   if (m.n_grains >= (1 << 27))  // list entries are packed as 16 j + image code while searching
     throw InputError("model: a periodic box holds at most 134,217,727 grains");

@@ -136,16 +136,27 @@ bool finite(const Quat& q) { return q.coeffs().allFinite(); }
 void check_state(Reader& r, const Model& m, const State& s) {
   const int n = m.n_grains;
   const auto where = [](const char* what, size_t k) { return std::string(what) + " " + std::to_string(k); };
-  if (!std::isfinite(s.time) || s.step < 0 || s.rebuilds < 0 || !(s.stats.max_disp2 >= 0) ||
-      !std::isfinite(s.stats.max_disp2))
-    r.fail("clock or step counters are invalid (time " + std::to_string(s.time) + ", step " +
-           std::to_string(s.step) + ")");
+  if (!(s.time >= 0 && s.time <= kMaxStateTime) || s.step < 0 || s.rebuilds < 0 || !(s.stats.max_disp2 >= 0) ||
+      !std::isfinite(s.stats.max_disp2)) {
+    char b[96];
+    std::snprintf(b, sizeof b, "time %.6g s, allowed [0, 1e9]; step %lld", s.time, (long long)s.step);
+    r.fail(std::string("clock or step counters are invalid (") + b + ")");
+  }
   const std::pair<const char*, const std::vector<Vec3>*> grain_vecs[] = {
       {"position", &s.pos}, {"velocity", &s.vel}, {"angular velocity", &s.omega},
       {"force", &s.force},   {"torque", &s.torque}, {"position at the last list build", &s.pos_at_build}};
   for (const auto& [what, v] : grain_vecs)
     for (size_t i = 0; i < v->size(); ++i)
       if (!finite((*v)[i])) r.fail(std::string("grain ") + std::to_string(i) + " has a non-finite " + what);
+  static_assert(kMaxStateTime == 1e9 && kMaxCoordinate == 1e6 && kMaxStateSpeed == 1e6,
+                "the messages name these bounds");
+  // Finite is not enough: a step, the neighbour grid and ROS time need values
+  // of a physical size (core/types.hpp).
+  const auto too_far = [](const Vec3& x) { return !(x.cwiseAbs().maxCoeff() <= kMaxCoordinate); };
+  const auto too_fast = [](const Vec3& v) { return !(v.cwiseAbs().maxCoeff() <= kMaxStateSpeed); };
+  for (size_t i = 0; i < s.pos.size() && i < s.vel.size() && i < s.omega.size(); ++i)
+    if (too_far(s.pos[i]) || too_fast(s.vel[i]) || too_fast(s.omega[i]))
+      r.fail("grain " + std::to_string(i) + " has a position beyond 1e6 m or a speed beyond 1e6 m/s (or rad/s)");
   // Grain pairs: rows of partners j > i, ascending; springs finite, flags 0/1.
   const PairList& pl = s.pairs;
   if (!pl.row_start.empty() || !pl.partner.empty()) {
@@ -189,6 +200,9 @@ void check_state(Reader& r, const Model& m, const State& s) {
     for (const Quat* q : {&x.q, &x.q_at_build})
       if (!finite(*q) || std::abs(q->norm() - 1) > 1e-6) r.fail(name + " has an orientation that is not a unit quaternion");
   }
+  for (size_t b = 0; b < s.bodies.size(); ++b)
+    if (too_far(s.bodies[b].pos) || too_fast(s.bodies[b].vel) || too_fast(s.bodies[b].omega))
+      r.fail("body " + std::to_string(b) + " has a position beyond 1e6 m or a speed beyond 1e6 m/s (or rad/s)");
   if (!(s.body_list_grain_disp >= 0) || !std::isfinite(s.body_list_grain_disp) || s.body_rebuilds < 0)
     r.fail("grain–body list counters are invalid");
   const BodyGrainList& bl = s.body_grains;

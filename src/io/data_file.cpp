@@ -2,14 +2,21 @@
 // and the size and nesting limits every file reader applies first.
 #include "regolith_twin/io/data_file.hpp"
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+#include <chrono>
 
 namespace rt {
 
@@ -24,7 +31,21 @@ void check_file_size(const std::string& path, std::size_t max_bytes, const std::
 
 std::string temp_name(const std::string& path) { return path + ".tmp." + std::to_string(::getpid()); }
 
+void check_regular_target(const std::string& path, const std::string& what) {
+  std::error_code ec;
+  const auto st = std::filesystem::status(path, ec);  // through a link: what the name stands for
+  if (ec || !std::filesystem::exists(st) || std::filesystem::is_regular_file(st)) return;
+  const char* kind = std::filesystem::is_directory(st) ? "a directory"
+                     : std::filesystem::is_character_file(st) || std::filesystem::is_block_file(st) ? "a device"
+                     : std::filesystem::is_fifo(st) ? "a named pipe"
+                     : std::filesystem::is_socket(st) ? "a socket" : "not a regular file";
+  throw InputError(path + ": is " + kind + ", not a file: " + what +
+                   " is written to a temporary file renamed over its target, which would replace it; give the path "
+                   "of a regular file (or of none yet)");
+}
+
 void write_file_replacing(const std::string& path, const std::string& bytes, const std::string& what, bool sync) {
+  check_regular_target(path, what);
   const std::string tmp = temp_name(path);
   std::FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) throw InputError(path + ": cannot create " + what + " (" + std::strerror(errno) + ")");
@@ -43,6 +64,73 @@ void write_file_replacing(const std::string& path, const std::string& bytes, con
     std::remove(tmp.c_str());
     throw InputError(path + ": could not write " + what + " (" + std::strerror(err) + ")");
   }
+}
+
+std::string path_inside(const std::string& dir, const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  if (path.empty()) throw InputError(what + ": the path is empty");
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  const fs::path root = fs::weakly_canonical(dir, ec);
+  if (ec) throw InputError(dir + ": the " + what + " directory cannot be used (" + ec.message() + ")");
+  const fs::path p = fs::path(path).is_absolute() ? fs::path(path) : fs::path(dir) / path;
+  const fs::path real = fs::weakly_canonical(p, ec);  // links followed where the path exists
+  if (ec) throw InputError(path + ": cannot resolve the " + what + " path (" + ec.message() + ")");
+  const auto [end, _] = std::mismatch(root.begin(), root.end(), real.begin(), real.end());
+  if (end != root.end() || real == root)
+    throw InputError(path + ": " + what + "s are kept in " + root.string() + " (resolved, this path is " +
+                     real.string() + "): give a name inside it, or start the node with another directory");
+  return real.string();
+}
+
+std::string read_file_bounded(const std::string& path, std::size_t max_bytes, const std::string& what,
+                              double timeout) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw InputError(path + ": cannot open " + what + " (" + std::strerror(errno) + ")");
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) throw InputError(path + ": cannot read " + what + " (" + std::strerror(errno) + ")");
+  const bool pipe = S_ISFIFO(st.st_mode);
+  if (!S_ISREG(st.st_mode) && !pipe)
+    throw InputError(path + ": is not a file or a named pipe: a " + what + " is read from a regular file");
+  if (!pipe && std::size_t(st.st_size) > max_bytes)
+    throw InputError(path + ": " + what + " of " + std::to_string(st.st_size) + " bytes is larger than the limit of " +
+                     std::to_string(max_bytes) + " bytes");
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout);
+  std::string data;
+  char chunk[65536];
+  for (;;) {
+    if (pipe) {
+      // Wait for data or the writer's end. Linux reports no hang-up on a
+      // pipe that has not had a writer yet, so a pipe nobody opens waits
+      // here, in slices, until the deadline.
+      const double left = std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
+      if (left <= 0) {
+        char b[48];
+        std::snprintf(b, sizeof b, "%g", timeout);
+        throw InputError(path + ": no " + what + " came through this pipe within " + b + " s: the read is given up");
+      }
+      struct pollfd q = {fd, POLLIN, 0};
+      const int r = ::poll(&q, 1, int(std::min(left, 0.1) * 1000) + 1);
+      if (r < 0 && errno != EINTR) throw InputError(path + ": cannot read " + what + " (" + std::strerror(errno) + ")");
+      if (r <= 0) continue;
+      if (!(q.revents & POLLIN)) break;  // the writer is gone: the end of the data
+    }
+    const ssize_t got = ::read(fd, chunk, sizeof chunk);
+    if (got > 0) {
+      data.append(chunk, std::size_t(got));
+      if (data.size() > max_bytes)
+        throw InputError(path + ": " + what + " is larger than the limit of " + std::to_string(max_bytes) + " bytes");
+    } else if (got == 0) {
+      break;
+    } else if (errno != EINTR && errno != EAGAIN) {
+      throw InputError(path + ": cannot read " + what + " (" + std::strerror(errno) + ")");
+    }
+  }
+  return data;
 }
 
 std::string read_file_limited(const std::string& path, std::size_t max_bytes, const std::string& what) {

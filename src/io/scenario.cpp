@@ -5,14 +5,17 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
 #include <sstream>
+#include <unordered_map>
 
 #include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/core/field.hpp"
+#include "regolith_twin/core/hold.hpp"
 #include "regolith_twin/core/walls.hpp"
 #include "regolith_twin/io/data_file.hpp"
 #include "regolith_twin/io/generate.hpp"
@@ -65,14 +68,14 @@ Material parse_material(const Reader& rd, const YAML::Node& node, const std::str
     rd.fail(Reader::join(path, "preset"), "unknown material preset '" + preset + "' (known: " + list + ")");
   }
   m.name = name;
-  m.density = rd.number(node, path, "density", m.density, 0, 1e6, true);
-  m.eps_n = rd.number(node, path, "eps_n", m.eps_n, 0, 1, true);
+  m.density = rd.number(node, path, "density", m.density, 1e-3, 1e6);
+  m.eps_n = rd.number(node, path, "eps_n", m.eps_n, 1e-3, 1);
   m.eps_t = rd.number(node, path, "eps_t", m.eps_t, 0, 1, true);
   m.mu_s = rd.number(node, path, "mu_s", m.mu_s, 0, 100);
   m.mu_r = rd.number(node, path, "mu_r", m.mu_r, 0, 100);
   m.mu_t = rd.number(node, path, "mu_t", m.mu_t, 0, 100);
   m.beta = rd.number(node, path, "beta", m.beta, 0, 10);
-  m.young = rd.number(node, path, "young", m.young, 0, 1e15);
+  m.young = rd.number(node, path, "young", m.young, 0, 1e13);
   m.poisson = rd.number(node, path, "poisson", m.poisson, -0.999, 0.499);
   m.kt_over_kn = rd.number(node, path, "kt_over_kn", m.kt_over_kn, 0, 10, true);
   m.ct_over_cn = rd.number(node, path, "ct_over_cn", m.ct_over_cn, -1, 10);
@@ -116,27 +119,27 @@ Wall parse_wall(const Reader& rd, const Model& m, const YAML::Node& w, const std
     out.origin = rd.vec3(w, path, "center", Vec3::Zero(), true);
     out.axis = unit(rd, rd.vec3(w, path, "normal", up), Reader::join(path, "normal"));
     if (type == "disk") {
-      out.radius = rd.number(w, path, "radius", 0, 0, kInf, true);
+      out.radius = rd.number(w, path, "radius", 0, 0, kMaxSceneLength, true);
     } else {
       Vec3 u = rd.vec3(w, path, "u", out.axis.unitOrthogonal());
       u -= u.dot(out.axis) * out.axis;
       out.u = unit(rd, u, Reader::join(path, "u"));
-      out.half_u = rd.number(w, path, "half_u", 0, 0, kInf, true);
-      out.half_v = rd.number(w, path, "half_v", 0, 0, kInf, true);
+      out.half_u = rd.number(w, path, "half_u", 0, 0, kMaxSceneLength, true);
+      out.half_v = rd.number(w, path, "half_v", 0, 0, kMaxSceneLength, true);
     }
   } else if (type == "cylinder" || type == "cone") {
     out.type = type == "cylinder" ? WallType::Cylinder : WallType::Cone;
     out.origin = rd.vec3(w, path, "base", Vec3::Zero(), true);
     out.axis = unit(rd, rd.vec3(w, path, "axis", up), Reader::join(path, "axis"));
-    out.radius = rd.number(w, path, "radius", 0, 0, kInf, true);
-    out.radius2 = type == "cone" ? rd.number(w, path, "radius2", 0, 0, kInf) : out.radius;
-    out.length = rd.number(w, path, "length", type == "cone" ? 1.0 : 0.0, type == "cone" ? 0 : -1, kInf,
+    out.radius = rd.number(w, path, "radius", 0, 0, kMaxSceneLength, true);
+    out.radius2 = type == "cone" ? rd.number(w, path, "radius2", 0, 0, kMaxSceneLength) : out.radius;
+    out.length = rd.number(w, path, "length", type == "cone" ? 1.0 : 0.0, type == "cone" ? 0 : -1, kMaxSceneLength,
                            type == "cone");
     out.inner = rd.boolean(w, path, "inner", true);
   } else {
     out.type = WallType::SphereShell;
     out.origin = rd.vec3(w, path, "center", Vec3::Zero(), true);
-    out.radius = rd.number(w, path, "radius", 0, 0, kInf, true);
+    out.radius = rd.number(w, path, "radius", 0, 0, kMaxSceneLength, true);
     out.inner = rd.boolean(w, path, "inner", true);
   }
   return out;
@@ -148,15 +151,31 @@ RadiusDist parse_radius(const Reader& rd, const YAML::Node& g, const std::string
   const std::string key = Reader::join(path, "radius");
   if (!r) rd.fail(key, "missing (a number, or {mean, sigma, cut})");
   if (r.IsScalar()) {
-    d.mean = rd.number(r, key, 0, kInf, true);
+    d.mean = rd.number(r, key, 1e-7, kMaxSceneLength);  // 0.1 um: below the finest dust
     return d;
   }
   rd.only(r, key, {"mean", "sigma", "cut"});
-  d.mean = rd.number(r, key, "mean", 0, 0, kInf, true);
+  if (!Reader::get(r, "mean")) rd.fail(Reader::join(key, "mean"), "missing (the mean radius, m)");
+  d.mean = rd.number(r, key, "mean", 0, 1e-7, kMaxSceneLength);
   d.sigma = rd.number(r, key, "sigma", 0, 0, 0.9);
-  d.cut = rd.number(r, key, "cut", 1.0, 0, 5);
+  d.cut = rd.number(r, key, "cut", 1.0, 0.1, 5);  // a narrower cut would reject almost every draw
   if (d.sigma * d.cut >= 1) rd.fail(key, "sigma * cut must be < 1 (radii must stay positive)");
   return d;
+}
+
+std::string num_text(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+// The keys that give a fill's region, with their values, for messages.
+std::string region_keys(const std::string& fp, const Region& r) {
+  if (r.shape == RegionShape::Box)
+    return Reader::join(fp, "lo") + " to " + Reader::join(fp, "hi") + ", " + num_text((r.hi - r.lo).x()) + " x " +
+           num_text((r.hi - r.lo).y()) + " x " + num_text((r.hi - r.lo).z()) + " m";
+  return Reader::join(fp, "radius") + " = " + num_text(r.radius) + " m, " + Reader::join(fp, "z") + " = [" +
+         num_text(r.lo.z()) + ", " + num_text(r.hi.z()) + "] m";
 }
 
 Region parse_region(const Reader& rd, const YAML::Node& f, const std::string& path) {
@@ -170,11 +189,11 @@ Region parse_region(const Reader& rd, const YAML::Node& f, const std::string& pa
   } else {
     r.shape = RegionShape::Cylinder;
     r.center = rd.vec3(f, path, "center", Vec3::Zero(), true);
-    r.radius = rd.number(f, path, "radius", 0, 0, kInf, true);
+    r.radius = rd.number(f, path, "radius", 0, 0, kMaxSceneLength, true);
     const YAML::Node z = f["z"];
     if (!z || !z.IsSequence() || z.size() != 2) rd.fail(Reader::join(path, "z"), "expected [z_min, z_max]");
-    const double z0 = rd.number(z[0], Reader::join(path, "z[0]"), -kInf, kInf);
-    const double z1 = rd.number(z[1], Reader::join(path, "z[1]"), z0, kInf, true);
+    const double z0 = rd.number(z[0], Reader::join(path, "z[0]"), -kMaxSceneLength, kMaxSceneLength);
+    const double z1 = rd.number(z[1], Reader::join(path, "z[1]"), z0, kMaxSceneLength, true);
     r.lo = Vec3(r.center.x() - r.radius, r.center.y() - r.radius, z0);
     r.hi = Vec3(r.center.x() + r.radius, r.center.y() + r.radius, z1);
   }
@@ -210,21 +229,23 @@ void parse_grains(const Reader& rd, Scenario& sc, const YAML::Node& g, const std
     const std::string arrangement = rd.choice(f, fp, "arrangement", "lattice", {"lattice", "random"});
     if (arrangement == "lattice") {
       if (f["gap"]) rd.fail(Reader::join(fp, "gap"), "applies to arrangement: random only");
-      const double spacing = rd.number(f, fp, "spacing", 2.1 * dist.max(), 2 * dist.max(), kInf);
+      const double spacing = rd.number(f, fp, "spacing", 2.1 * dist.max(), 2 * dist.max(), kMaxSceneLength);
       const double jitter = rd.number(f, fp, "jitter", 0.05 * (spacing - 2 * dist.max()) + 0.01 * dist.mean, 0,
                                       0.5 * spacing);
       pos = lattice_sites(region, spacing, dist.max(), jitter, int(count), rng);
       if (long(pos.size()) < count)
-        rd.fail(Reader::join(fp, "count"), std::to_string(count) + " grains do not fit in the region at spacing " +
-                                                std::to_string(spacing) + " m (room for " +
-                                                std::to_string(pos.size()) + ")");
+        rd.fail(Reader::join(fp, "count"), std::to_string(count) + " grains do not fit in the region (room for " +
+                                                std::to_string(pos.size()) + ") at " + Reader::join(fp, "spacing") +
+                                                " = " + num_text(spacing) + " m (from " + Reader::join(path, "radius") +
+                                                " " + num_text(dist.mean) + " m): make the region (" +
+                                                region_keys(fp, region) + ") larger or the grains fewer");
       radii = draw_radii(dist, int(pos.size()), rng);
     } else {
       // Random sequential addition (docs/scenes.md E.1): radii first, then
       // each grain at a uniform position clear of the earlier ones by `gap`.
       for (const char* k : {"spacing", "jitter"})
         if (f[k]) rd.fail(Reader::join(fp, k), "applies to arrangement: lattice only");
-      const double gap = rd.number(f, fp, "gap", 0.1 * dist.mean, 0, kInf);
+      const double gap = rd.number(f, fp, "gap", 0.1 * dist.mean, 0, kMaxSceneLength);
       const std::vector<double> drawn = draw_radii(dist, int(count), rng);
       RandomFill fill = random_sites(region, drawn, 0.0, gap, 20000, rng);
       if (long(fill.sites.size()) < count)
@@ -274,8 +295,8 @@ Quat parse_orientation(const Reader& rd, const YAML::Node& parent, const std::st
   if (o["quaternion"]) {
     const YAML::Node qn = o["quaternion"];
     if (!qn.IsSequence() || qn.size() != 4) rd.fail(p + ".quaternion", "expected [w, x, y, z]");
-    Quat q(rd.number(qn[0], p + ".quaternion[0]", -kInf, kInf), rd.number(qn[1], p + ".quaternion[1]", -kInf, kInf),
-           rd.number(qn[2], p + ".quaternion[2]", -kInf, kInf), rd.number(qn[3], p + ".quaternion[3]", -kInf, kInf));
+    Quat q(rd.number(qn[0], p + ".quaternion[0]", -1e6, 1e6), rd.number(qn[1], p + ".quaternion[1]", -1e6, 1e6),
+           rd.number(qn[2], p + ".quaternion[2]", -1e6, 1e6), rd.number(qn[3], p + ".quaternion[3]", -1e6, 1e6));
     if (!(q.norm() > 0)) rd.fail(p + ".quaternion", "must be non-zero");
     return q.normalized();
   }
@@ -300,11 +321,11 @@ Shape parse_shape(const Reader& rd, const YAML::Node& n, const std::string& path
     sh.size = type == "box" ? Vec3(v / 2) : v;
   } else if (type == "sphere") {
     sh.type = ShapeType::Sphere;
-    sh.size = Vec3::Constant(rd.number(n, path, "radius", 0, 0, kInf, true));
+    sh.size = Vec3::Constant(rd.number(n, path, "radius", 0, 0, kMaxSceneLength, true));
     if (!n["radius"]) rd.fail(Reader::join(path, "radius"), "missing (m, > 0)");
   } else {
     sh.type = ShapeType::Cylinder;
-    const double r = rd.number(n, path, "radius", 0, 0, kInf, true), l = rd.number(n, path, "length", 0, 0, kInf, true);
+    const double r = rd.number(n, path, "radius", 0, 0, kMaxSceneLength, true), l = rd.number(n, path, "length", 0, 0, kMaxSceneLength, true);
     if (!n["radius"] || !n["length"]) rd.fail(path, "a cylinder needs radius and length (m, > 0)");
     sh.size = Vec3(r, r, l / 2);
   }
@@ -349,9 +370,14 @@ void parse_body(const Reader& rd, Scenario& sc, const YAML::Node& n, const std::
     for (size_t k = 0; k < shapes.size(); ++k)
       b.shapes.push_back(parse_shape(rd, shapes[k], Reader::join(path, "shapes[" + std::to_string(k) + "]")));
     if (!b.fixed) {
-      b.mass = rd.number(n, path, "mass", 0, 0, kInf, true);
+      b.mass = rd.number(n, path, "mass", 0, 1e-9, kMaxSceneMass);
       if (!n["mass"]) rd.fail(Reader::join(path, "mass"), "missing (kg, > 0)");
       b.inertia = rd.vec3(n, path, "inertia", Vec3::Zero(), true);  // principal moments about the shapes' axes
+      const Vec3& I = b.inertia;
+      if (!(I.minCoeff() > 0)) rd.fail(Reader::join(path, "inertia"), "principal moments must be > 0 kg m^2");
+      for (int k = 0; k < 3; ++k)
+        if (I[k] > I[(k + 1) % 3] + I[(k + 2) % 3])
+          rd.fail(Reader::join(path, "inertia"), "principal moments violate I_a <= I_b + I_c (not a physical body)");
       const Vec3 com = rd.vec3(n, path, "center_of_mass", Vec3::Zero());
       for (Shape& sh : b.shapes) sh.pos -= com;
       b.ref_pos = com;
@@ -434,6 +460,13 @@ void apply_override(YAML::Node root, const std::string& assignment) {
 
 }  // namespace
 
+std::string body_names_text(const Model& m) {
+  std::string t;
+  for (size_t k = 0; k < m.bodies.size(); ++k)
+    t += (k ? ", " : "") + std::string("bodies[") + std::to_string(k) + "].name = '" + m.bodies[k].name + "'";
+  return t.empty() ? "no bodies" : t;
+}
+
 bool material_preset(const std::string& name, Material& out) {
   const auto it = presets().find(name);
   if (it == presets().end()) return false;
@@ -471,6 +504,89 @@ const GrainGroup* Scenario::group(const std::string& n) const {
 }
 
 namespace {
+
+// The keys that place a wall, and a grains entry, for the messages below.
+std::string wall_keys(const Wall& w, size_t k) {
+  const std::string p = "walls[" + std::to_string(k) + "].";
+  switch (w.type) {
+    case WallType::Plane: return p + "point, " + p + "normal";
+    case WallType::Disk: return p + "center, " + p + "normal, " + p + "radius";
+    case WallType::Rectangle: return p + "center, " + p + "normal, " + p + "u, " + p + "half_u, " + p + "half_v";
+    case WallType::Cylinder: return p + "base, " + p + "axis, " + p + "radius, " + p + "length";
+    case WallType::Cone: return p + "base, " + p + "axis, " + p + "radius, " + p + "radius2, " + p + "length";
+    default: return p + "center, " + p + "radius";
+  }
+}
+
+std::string grain_keys(const YAML::Node& root, size_t g) {
+  const std::string p = "grains[" + std::to_string(g) + "].";
+  const YAML::Node e = root["grains"][g];
+  if (e["position"]) return p + "position, " + p + "radius";
+  if (e["file"]) return p + "file";
+  const YAML::Node f = e["fill"];
+  if (f && f["center"]) return p + "fill.center, " + p + "fill.radius, " + p + "fill.z, " + p + "radius";
+  return p + "fill.lo, " + p + "fill.hi, " + p + "fill.spacing, " + p + "radius";
+}
+
+// Grains that start where no step could sort them out (docs/scenes.md,
+// "Input ranges"): a centre on the far side of a wall's surface, or two
+// grains overlapping by more than half the smaller radius (coincident
+// grains; two glued grains exert no force on each other and may). Refused naming the keys that place them, before any step.
+void check_start_positions(const Reader& rd, const YAML::Node& root, const Scenario& sc) {
+  const Model& m = sc.model;
+  const State& s = sc.initial;
+  const auto group_of = [&](int i) {
+    for (size_t g = 0; g < sc.groups.size(); ++g)
+      if (i >= sc.groups[g].first && i < sc.groups[g].first + sc.groups[g].count) return g;
+    return size_t(0);
+  };
+  char b[160];
+  for (size_t w = 0; w < m.walls.size(); ++w) {
+    int count = 0, first = -1;
+    for (int i = 0; i < m.n_grains; ++i)
+      if (wall_gap(m.walls[w], s.pos[i], m.grain_radius[i]).overlap > m.grain_radius[i]) {
+        if (first < 0) first = i;
+        ++count;
+      }
+    if (count == 0) continue;
+    const size_t g = group_of(first);
+    std::snprintf(b, sizeof b, "%d grain(s) start with their centre beyond the surface of walls[%zu] ('%s'), the first at (%.4g, %.4g, %.4g) m",
+                  count, w, m.walls[w].name.c_str(), s.pos[first].x(), s.pos[first].y(), s.pos[first].z());
+    rd.fail("grains[" + std::to_string(g) + "]", std::string(b) + ": the wall (" + wall_keys(m.walls[w], w) +
+                                                     ") and the grains (" + grain_keys(root, g) + ") do not agree");
+  }
+  // Coincident grains: a grid of cells two of the largest radii wide.
+  if (m.n_grains < 2) return;
+  double rmax = 0;
+  for (int i = 0; i < m.n_grains; ++i) rmax = std::max(rmax, m.grain_radius[i]);
+  const double cell = 2 * rmax;
+  std::unordered_map<long long, std::vector<int>> grid;
+  const auto key = [&](long long x, long long y, long long z) { return (x * 73856093LL) ^ (y * 19349663LL) ^ (z * 83492791LL); };
+  const auto coord = [&](double v) { return (long long)std::floor(v / cell); };
+  for (int i = 0; i < m.n_grains; ++i)
+    grid[key(coord(s.pos[i].x()), coord(s.pos[i].y()), coord(s.pos[i].z()))].push_back(i);
+  for (int i = 0; i < m.n_grains; ++i) {
+    const long long cx = coord(s.pos[i].x()), cy = coord(s.pos[i].y()), cz = coord(s.pos[i].z());
+    for (long long dx = -1; dx <= 1; ++dx)
+      for (long long dy = -1; dy <= 1; ++dy)
+        for (long long dz = -1; dz <= 1; ++dz) {
+          const auto it = grid.find(key(cx + dx, cy + dy, cz + dz));
+          if (it == grid.end()) continue;
+          for (const int j : it->second) {
+            if (j <= i || (held(m, i) && held(m, j))) continue;  // glued grains never meet
+            const double ri = m.grain_radius[i], rj = m.grain_radius[j];
+            const double overlap = ri + rj - (s.pos[i] - s.pos[j]).norm();
+            if (overlap <= 0.5 * std::min(ri, rj)) continue;
+            const size_t gi = group_of(i), gj = group_of(j);
+            std::snprintf(b, sizeof b, "grains %d and %d start overlapping by %.3g m (more than half the smaller radius) at (%.4g, %.4g, %.4g) m",
+                          i, j, overlap, s.pos[i].x(), s.pos[i].y(), s.pos[i].z());
+            rd.fail("grains[" + std::to_string(gi) + "]",
+                    std::string(b) + ": no step can part them; place them apart (" + grain_keys(root, gi) +
+                        (gi != gj ? "; " + grain_keys(root, gj) : std::string()) + ")");
+          }
+        }
+  }
+}
 
 Scenario interpret_scenario(const YAML::Node& root, const std::string& source, const DerivedContact& derived) {
   const Reader rd(source);
@@ -537,8 +653,8 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
   } else {
     mean_mass /= m.n_grains;
   }
-  sc.v_ref = rd.number(c, "contact", "v_max", 1.0, 0, 1e5, true);
-  const double x_max = rd.number(c, "contact", "x_max", 0.01, 0, 0.5, true) * min_r;
+  sc.v_ref = rd.number(c, "contact", "v_max", 1.0, 1e-6, 1e5);
+  const double x_max = rd.number(c, "contact", "x_max", 0.01, 1e-6, 0.5) * min_r;
   if (derived.kn > 0 && Reader::get(c, "kn"))
     rd.fail("contact.kn", "set from " + derived.by + " in this scene: remove it here");
   if (derived.dt > 0 && Reader::get(c, "dt"))
@@ -546,7 +662,7 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
   if (derived.kn > 0)
     m.kn = derived.kn;
   else if (Reader::get(c, "kn") && !(c["kn"].IsScalar() && c["kn"].Scalar() == "rule"))
-    m.kn = rd.number(c["kn"], "contact.kn", 0, kInf, true);
+    m.kn = rd.number(c["kn"], "contact.kn", 1e-6, kMaxSceneStiffness);
   else
     m.kn = kn_rule(mean_mass, sc.v_ref, x_max);
   const double n_steps = rd.number(c, "contact", "steps_per_contact", 30, 1, 1e6);
@@ -560,8 +676,9 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
     rd.fail("contact.dt", "missing: the Hertz–Mindlin law needs an explicit dt");
   }
   // Body–body stiffness of one shape pair (docs/model.md §6); absent: the scene k_n.
-  m.body_kn = rd.number(c, "contact", "body_kn", 0, 0, kInf, true);
-  m.skin = rd.number(c, "contact", "skin", 0, 0, kInf);
+  m.body_kn = rd.number(c, "contact", "body_kn", 0, 0, kMaxSceneStiffness, true);
+  m.skin = rd.number(c, "contact", "skin", 0, 0, 1);
+  if (m.skin > 0 && m.skin < 1e-9) rd.fail("contact.skin", "value below 1e-9 m: give 0 (the default list skin) or a skin of at least 1e-9 m");
   m.partitions = int(rd.integer(c, "contact", "partitions", 4, 1, 256));
 
   const YAML::Node gd = rd.map(root, "", "guards", false);
@@ -582,10 +699,10 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
   rd.only(sl, "sleep", {"enabled", "speed", "time", "force", "cell", "check_every", "at_start"});
   SleepParams& sp = m.sleep;
   sp.enabled = rd.boolean(sl, "sleep", "enabled", false);
-  sp.speed = rd.number(sl, "sleep", "speed", sp.speed, 0, kInf, true);
-  sp.time = rd.number(sl, "sleep", "time", sp.time, 0, kInf);
-  sp.force = rd.number(sl, "sleep", "force", sp.force, 0, kInf, true);
-  sp.cell = rd.number(sl, "sleep", "cell", sp.cell, 0, kInf);
+  sp.speed = rd.number(sl, "sleep", "speed", sp.speed, 0, kMaxSceneSpeed, true);
+  sp.time = rd.number(sl, "sleep", "time", sp.time, 0, kMaxSceneDuration);
+  sp.force = rd.number(sl, "sleep", "force", sp.force, 0, 1e9, true);
+  sp.cell = rd.number(sl, "sleep", "cell", sp.cell, 0, kMaxSceneLength);
   sp.check_every = int(rd.integer(sl, "sleep", "check_every", sp.check_every, 1, 1000000));
   sp.at_start = rd.boolean(sl, "sleep", "at_start", sp.at_start);
 
@@ -598,7 +715,7 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
                       true);
   q.margin = rd.number(sh, "schedule", "margin", q.margin, 1, 100);
   q.floor = rd.number(sh, "schedule", "floor", q.floor, 1e-8, 1);
-  q.after = rd.number(sh, "schedule", "after", q.after, 0, kInf);
+  q.after = rd.number(sh, "schedule", "after", q.after, 0, kMaxSceneDuration);
   q.check_every = int(rd.integer(sh, "schedule", "check_every", q.check_every, 1, 1000000));
 
   // Free flight (docs/model.md §18).
@@ -616,8 +733,8 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
     if (!n) continue;
     const std::string path = "periodic." + key;
     if (!n.IsSequence() || n.size() != 2) rd.fail(path, "expected [lo, hi] (m)");
-    const double lo = rd.number(n[0], path + "[0]", -kInf, kInf);
-    const double hi = rd.number(n[1], path + "[1]", lo, kInf, true);
+    const double lo = rd.number(n[0], path + "[0]", -kMaxSceneLength, kMaxSceneLength);
+    const double hi = rd.number(n[1], path + "[1]", lo, kMaxSceneLength, true);
     (a == 0 ? m.periodic.x : m.periodic.y) = true;
     m.periodic.lo[a] = lo;
     m.periodic.length[a] = hi - lo;
@@ -629,9 +746,9 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
                          "shear", "u_log", "h_log", "anchor_z", "drag", "lift", "radial", "nozzle",
                          "density_length"});
     GasFlowParams g;
-    g.density = rd.number(gas, "gas", "density", 0, 0, kInf, true);
-    g.viscosity = rd.number(gas, "gas", "viscosity", 0, 0, kInf, true);
-    g.sound_speed = rd.number(gas, "gas", "sound_speed", 0, 0, kInf, true);
+    g.density = rd.number(gas, "gas", "density", 0, 0, 1e4, true);
+    g.viscosity = rd.number(gas, "gas", "viscosity", 0, 0, 1e3, true);
+    g.sound_speed = rd.number(gas, "gas", "sound_speed", 0, 0, kMaxSceneSpeed, true);
     if (!(g.density > 0) || !(g.viscosity > 0) || !(g.sound_speed > 0))
       rd.fail("gas", "density (kg/m^3), viscosity (Pa s) and sound_speed (m/s) are required");
     g.gamma = rd.number(gas, "gas", "gamma", g.gamma, 1, 10, true);
@@ -642,16 +759,16 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
     g.u0 = rd.number(gas, "gas", "u0", 0, -1e5, 1e5);
     g.shear = rd.number(gas, "gas", "shear", 0, -1e9, 1e9);
     g.u_log = rd.number(gas, "gas", "u_log", 0, -1e5, 1e5);
-    g.h_log = rd.number(gas, "gas", "h_log", 0, 0, kInf);
+    g.h_log = rd.number(gas, "gas", "h_log", 0, 0, kMaxSceneLength);
     if (g.u_log != 0 && !(g.h_log > 0)) rd.fail("gas.h_log", "required (> 0 m) with u_log");
-    g.anchor_z = rd.number(gas, "gas", "anchor_z", 0, -kInf, kInf);
+    g.anchor_z = rd.number(gas, "gas", "anchor_z", 0, -kMaxSceneLength, kMaxSceneLength);
     g.drag = rd.boolean(gas, "gas", "drag", true);
     g.lift = rd.boolean(gas, "gas", "lift", true);
     g.radial = rd.boolean(gas, "gas", "radial", false);
     g.nozzle = rd.vec3(gas, "gas", "nozzle", Vec3::Zero());
-    g.density_length = rd.number(gas, "gas", "density_length", 0, 0, kInf);
+    g.density_length = rd.number(gas, "gas", "density_length", 0, 0, kMaxSceneLength);
     if ((g.radial || g.density_length > 0) && !YamlReader::get(gas, "nozzle"))
-      rd.fail("gas.nozzle", "required with radial or density_length: the nozzle's position [x, y, z] (m)");
+      rd.fail("gas.nozzle", "required with gas.radial or gas.density_length: the nozzle's position [x, y, z] (m)");
     m.fields.push_back(std::make_shared<GasField>(g));
   }
 
@@ -666,11 +783,18 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
 
   // Resolution report: warn below 10 steps per contact, refuse below 4.
   sc.resolution = pair_resolution(m, sc.v_ref);
+  std::string mat_keys;
+  for (const Material& mat : m.materials) mat_keys += (mat_keys.empty() ? "" : ", ") + std::string("materials.") + mat.name;
   for (const auto& r : sc.resolution) {
     std::ostringstream os;
     os << r.label << ": " << r.steps << " steps per contact";
     if (r.steps < m.guards.min_steps_per_contact_refuse && !m.guards.allow_under_resolved)
-      rd.fail("contact.dt", os.str() + " (below 4; set guards.allow_under_resolved: true to run anyway)");
+      rd.fail("contact.dt", os.str() +
+                                " (below 4; set guards.allow_under_resolved: true to run anyway). The contact time "
+                                "of a pair comes from its masses and damping (" + mat_keys +
+                                ": density, eps_n; the grains' radius; bodies[i].mass), k_n (contact.kn, "
+                                "contact.v_max, contact.x_max, contact.body_kn) and dt (contact.dt, "
+                                "contact.steps_per_contact)");
     if (r.steps < m.guards.min_steps_per_contact_warn) sc.warnings.push_back(os.str() + " (below 10)");
   }
 
@@ -683,6 +807,8 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
   sc.initial.pos = pos;
   sc.initial.vel = vel;
   sc.initial.omega = omg;
+
+  check_start_positions(rd, root, sc);
 
   // Bodies buried in a bed ('carve: true'): the grains they overlap make room.
   if (!sc.carve.empty()) {
@@ -718,7 +844,12 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
         if (!h.IsSequence()) rd.fail(p + ".hold", "expected a list of grain group names");
         for (const auto& x : h) {
           const std::string gname = x.as<std::string>();
-          if (!sc.group(gname)) rd.fail(p + ".hold", "unknown grain group '" + gname + "'");
+          if (!sc.group(gname)) {
+            std::string names;
+            for (size_t k = 0; k < sc.groups.size(); ++k)
+              names += (k ? ", " : "") + std::string("grains[") + std::to_string(k) + "].name = '" + sc.groups[k].name + "'";
+            rd.fail(p + ".hold", "unknown grain group '" + gname + "' (the groups: " + names + ")");
+          }
           s.hold.push_back(gname);
         }
       }
@@ -728,14 +859,19 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
           const std::string wname = x.as<std::string>();
           bool found = false;
           for (const auto& w : m.walls) found = found || w.name == wname;
-          if (!found) rd.fail(p + ".remove_walls", "unknown wall '" + wname + "' (walls need a 'name')");
+          if (!found) {
+            std::string names;
+            for (size_t k = 0; k < m.walls.size(); ++k)
+              names += (k ? ", " : "") + std::string("walls[") + std::to_string(k) + "].name = '" + m.walls[k].name + "'";
+            rd.fail(p + ".remove_walls", "unknown wall '" + wname + "' (the walls: " + (names.empty() ? "none" : names) + ")");
+          }
           s.remove_walls.push_back(wname);
         }
       }
       // Stop criteria: absent = off (-1 inside); given, a speed > 0.
-      s.until_rms_speed = st[i]["until_rms_speed"] ? rd.number(st[i], p, "until_rms_speed", -1, 0, kInf, true) : -1;
-      s.until_max_speed = st[i]["until_max_speed"] ? rd.number(st[i], p, "until_max_speed", -1, 0, kInf, true) : -1;
-      s.check_every = rd.number(st[i], p, "check_every", 0.01, 0, kInf, true);
+      s.until_rms_speed = st[i]["until_rms_speed"] ? rd.number(st[i], p, "until_rms_speed", -1, 0, kMaxSceneSpeed, true) : -1;
+      s.until_max_speed = st[i]["until_max_speed"] ? rd.number(st[i], p, "until_max_speed", -1, 0, kMaxSceneSpeed, true) : -1;
+      s.check_every = rd.number(st[i], p, "check_every", 0.01, 0, kMaxSceneDuration, true);
       if (st[i]["gravity"]) {
         s.set_gravity = true;
         s.gravity = rd.vec3(st[i], p, "gravity", Vec3::Zero(), true);
@@ -743,17 +879,19 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
       s.gravity_ramp = rd.number(st[i], p, "gravity_ramp", 0, 0, s.duration);
       if (s.gravity_ramp > 0 && !s.set_gravity) rd.fail(p + ".gravity_ramp", "needs a 'gravity' to ramp to");
       s.stiffness_scale = rd.number(st[i], p, "stiffness_scale", 0, 0, 1);
-      s.max_injection = rd.number(st[i], p, "max_injection", -1, 0, kInf);
+      if (s.stiffness_scale > 0 && s.stiffness_scale < 1e-6)
+        rd.fail(p + ".stiffness_scale", "value below 1e-6: give 0 (keep the scene's k_n) or a scale in [1e-6, 1]");
+      s.max_injection = rd.number(st[i], p, "max_injection", -1, 0, 1e6);
       if (st[i]["max_injection"] && s.stiffness_scale <= 0)
         rd.fail(p + ".max_injection", "needs a 'stiffness_scale' (the check is made when k_n changes)");
-      s.quench_every = rd.number(st[i], p, "quench_every", 0, 0, kInf);
+      s.quench_every = rd.number(st[i], p, "quench_every", 0, 0, kMaxSceneDuration);
       s.minimize = rd.boolean(st[i], p, "minimize", false);
       s.release_springs = rd.boolean(st[i], p, "release_springs", false);
       s.trim_tops = rd.boolean(st[i], p, "trim_tops", false);
       if (st[i]["trim_tops"] && !st[i]["trim_above"]) rd.fail(p + ".trim_tops", "needs a 'trim_above' height");
       if (st[i]["trim_above"]) {
         s.trim = true;
-        s.trim_above = rd.number(st[i], p, "trim_above", 0, -kInf, kInf);
+        s.trim_above = rd.number(st[i], p, "trim_above", 0, -kMaxSceneLength, kMaxSceneLength);
         // A trim plane at or below a floor (a plane wall facing up) would remove every grain.
         for (const Wall& w : m.walls)
           if (w.type == WallType::Plane && w.axis.z() > 1 - 1e-9 && !(s.trim_above > w.origin.z()))
@@ -768,7 +906,7 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
   }
   const YAML::Node out = rd.map(root, "", "output", false);
   rd.only(out, "output", {"every"});
-  sc.output_every = rd.number(out, "output", "every", 0.01, 0, kInf, true);
+  sc.output_every = rd.number(out, "output", "every", 0.01, 0, kMaxSceneDuration, true);
   return sc;
 }
 

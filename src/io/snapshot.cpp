@@ -74,7 +74,8 @@ std::vector<SnapshotGrain> read_snapshot(const std::string& path) {
       out[i].pos = Vec3(rec[0], rec[1], rec[2]);
       out[i].radius = rec[3];
     }
-    if (!(out[i].radius > 0) || !out[i].pos.allFinite()) fail("grain " + std::to_string(i) + " has an invalid radius or position");
+    if (!(out[i].radius > 0 && out[i].radius <= kMaxCoordinate) || !(out[i].pos.cwiseAbs().maxCoeff() <= kMaxCoordinate))
+      fail("grain " + std::to_string(i) + " has an invalid radius or a position beyond 1e6 m");
   }
   return out;
 }

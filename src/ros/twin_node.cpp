@@ -12,7 +12,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -26,6 +28,7 @@
 #include "regolith_twin/core/energy.hpp"
 #include "regolith_twin/run/series.hpp"
 #include "regolith_twin/io/checkpoint.hpp"
+#include "regolith_twin/io/data_file.hpp"
 
 namespace rt_ros {
 namespace {
@@ -123,7 +126,18 @@ NodeParams read_params(const ros::NodeHandle& pnh) {
   p.wait_for_recorder = param_bool(pnh, "wait_for_recorder", false);
   p.threads = int(param_number(pnh, "threads", 0, 0, 256));
   p.max_step_wall = param_number(pnh, "max_step_wall", 600, 1e-3, 1e7);
+  p.checkpoint_dir = param_text(pnh, "checkpoint_dir", "");
+  p.io_timeout = param_number(pnh, "io_timeout", 30, 1e-3, 1e5);
+  p.max_steps = long(param_number(pnh, "max_steps", 0, 0, 1e15));
   return p;
+}
+
+std::string checkpoint_dir(const NodeParams& p) {
+  if (!p.checkpoint_dir.empty()) return p.checkpoint_dir;
+  if (!p.out_dir.empty()) return p.out_dir + "/checkpoints";
+  const char* ros_home = std::getenv("ROS_HOME");
+  const char* home = std::getenv("HOME");
+  return (ros_home ? std::string(ros_home) : std::string(home ? home : ".") + "/.ros") + "/regolith_twin/checkpoints";
 }
 
 TwinNode::TwinNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeParams& p) : nh_(nh), pnh_(pnh), p_(p) {
@@ -137,6 +151,10 @@ TwinNode::TwinNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeParams& p)
   to.overrides = p_.overrides;
   to.scene.cache_dir = p_.cache_dir;
   to.scene.quiet = false;
+  // An interactive twin steps on request, is paused and cancelled from
+  // outside, and may run an endless scene: no limit unless one is asked for.
+  to.scene.max_steps = p_.max_steps > 0 ? p_.max_steps : std::numeric_limits<long>::max();
+  checkpoint_dir_ = checkpoint_dir(p_);
   twin_ = std::make_unique<rt::Twin>(to);
   paused_ = p_.start_paused || p_.wait_for_recorder;
   waiting_for_recorder_ = p_.wait_for_recorder && !p_.start_paused;
@@ -155,8 +173,12 @@ TwinNode::TwinNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeParams& p)
   services_.push_back(pnh_.advertiseService("unpause", &TwinNode::on_unpause, this));
   services_.push_back(pnh_.advertiseService("reset", &TwinNode::on_reset, this));
   services_.push_back(pnh_.advertiseService("step", &TwinNode::on_step, this));
-  services_.push_back(pnh_.advertiseService("save_checkpoint", &TwinNode::on_save, this));
-  services_.push_back(pnh_.advertiseService("load_checkpoint", &TwinNode::on_load, this));
+  {
+    ros::NodeHandle io(pnh_);
+    io.setCallbackQueue(&io_queue_);
+    services_.push_back(io.advertiseService("save_checkpoint", &TwinNode::on_save, this));
+    services_.push_back(io.advertiseService("load_checkpoint", &TwinNode::on_load, this));
+  }
   services_.push_back(pnh_.advertiseService("set_body_state", &TwinNode::on_set_body_state, this));
   services_.push_back(pnh_.advertiseService("apply_body_wrench", &TwinNode::on_apply_wrench, this));
 
@@ -184,9 +206,12 @@ void TwinNode::start() {
     after_step(true);
   }
   thread_ = std::thread([this] { loop(); });
+  io_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &io_queue_);
+  io_spinner_->start();
 }
 
 void TwinNode::stop() {
+  if (io_spinner_) io_spinner_->stop();
   running_ = false;
   cv_.notify_all();
   step_cv_.notify_all();
@@ -802,7 +827,8 @@ bool TwinNode::on_step(regolith_twin::Step::Request& req, regolith_twin::Step::R
 // slow or blocking path never stops /clock or the other services.
 bool TwinNode::on_save(regolith_twin::Checkpoint::Request& req, regolith_twin::Checkpoint::Response& res) {
   try {
-    if (req.path.empty()) throw rt::InputError("path is empty");
+    const std::string path = rt::path_inside(checkpoint_dir_, req.path, "checkpoint");
+    rt::check_regular_target(path, "a checkpoint");
     std::string image;
     double t = 0;
     {
@@ -810,9 +836,9 @@ bool TwinNode::on_save(regolith_twin::Checkpoint::Request& req, regolith_twin::C
       image = twin_->checkpoint_image();
       t = twin_->state().time;
     }
-    rt::write_checkpoint_file(req.path, image);
+    rt::write_checkpoint_file(path, image);
     res.success = true;
-    res.message = "saved t = " + std::to_string(t) + " s to " + req.path;
+    res.message = "saved t = " + std::to_string(t) + " s to " + path;
   } catch (const std::exception& e) {
     res.success = false;
     res.message = e.what();
@@ -822,9 +848,10 @@ bool TwinNode::on_save(regolith_twin::Checkpoint::Request& req, regolith_twin::C
 
 bool TwinNode::on_load(regolith_twin::Checkpoint::Request& req, regolith_twin::Checkpoint::Response& res) {
   try {
-    const std::string data = rt::read_checkpoint_file(req.path);
+    const std::string path = rt::path_inside(checkpoint_dir_, req.path, "checkpoint");
+    const std::string data = rt::read_file_bounded(path, rt::kMaxCheckpointBytes, "checkpoint", p_.io_timeout);
     std::lock_guard<std::mutex> lk(mu_);
-    twin_->load_image(req.path, data);
+    twin_->load_image(path, data);
     failed_ = false;
     failure_.clear();
     end_handled_ = false;
@@ -832,7 +859,7 @@ bool TwinNode::on_load(regolith_twin::Checkpoint::Request& req, regolith_twin::C
     reset_pacing();
     after_step(true);
     res.success = true;
-    res.message = "loaded t = " + std::to_string(twin_->state().time) + " s from " + req.path;
+    res.message = "loaded t = " + std::to_string(twin_->state().time) + " s from " + path;
   } catch (const std::exception& e) {
     res.success = false;
     res.message = e.what();

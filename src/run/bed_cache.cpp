@@ -131,8 +131,13 @@ RelaxedBed relax_bed(Scenario& sc, const State& s0, const std::vector<int>& plac
   out.cache = cache + "/beds/" + key + ".ckpt";
   const std::string grains = cache + "/beds/" + key + ".grains";
   if (std::ifstream(out.cache).good() && (!trims || std::ifstream(grains).good())) {
-    if (trims) load_grains(grains, sc);
-    out.state = load_checkpoint(out.cache, m);
+    try {
+      if (trims) load_grains(grains, sc);
+      out.state = load_checkpoint(out.cache, m);
+    } catch (const InputError& e) {
+      throw InputError(std::string(e.what()) + "\n  this is a cached relaxed bed: delete it (rm " + out.cache +
+                       (trims ? " " + grains : std::string()) + ") and the bed is relaxed again");
+    }
     out.from_cache = true;
     if (!opt.quiet) std::fprintf(stderr, "[%s] relaxed bed from the cache: %s\n", label.c_str(), out.cache.c_str());
     return out;
@@ -144,6 +149,7 @@ RelaxedBed relax_bed(Scenario& sc, const State& s0, const std::vector<int>& plac
   RunOptions ro;
   ro.out_dir = opt.relax_out;
   ro.progress_every = opt.quiet ? 0 : 5.0;
+  ro.max_steps = opt.max_steps;
   // The relaxation runs on a copy of the scenario without sleeping or a
   // stiffness schedule: a bed is prepared by the same dynamics whatever the
   // scene later skips, and the stages' settings (gravity, stiffness scale) do not stay in the scene's

@@ -3,6 +3,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cerrno>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -19,6 +21,7 @@
 #include "regolith_twin/io/checkpoint.hpp"
 #include "regolith_twin/io/data_file.hpp"
 #include "regolith_twin/io/snapshot.hpp"
+#include "regolith_twin/io/yaml_reader.hpp"
 
 namespace rt {
 namespace {
@@ -37,9 +40,12 @@ void usage(std::FILE* f, const char* tool) {
                "  --snapshot-precision 32|64  positions of the snapshot in float32 (default) or float64 (stiff beds)\n"
                "  --checkpoint F  also write the exact final state (with contact history) to F\n"
                "  --stage-snapshots  also write DIR/<stage>.bed after every stage (restart points)\n"
+               "  --max-steps N   refuse a run longer than N steps (default %ld: a run past it stops with status\n"
+               "                  step_limit); raise it for a run that needs more\n"
+               "  --list-keys     print every key the scene's readers ask for (key and kind) and exit\n"
                "  --quiet         no progress lines\n"
                "scene kinds: a plain scenario, or a file with one of these blocks:",
-               tool);
+               tool, kDefaultMaxSteps);
   for (const std::string& k : scene_kind_names()) std::fprintf(f, " %s:", k.c_str());
   std::fprintf(f, "\n");
 }
@@ -48,7 +54,8 @@ struct Args {
   std::string file, out, cache, snapshot, checkpoint, profile, relaxed_bed;
   std::vector<std::string> overrides;
   int threads = 0;
-  bool quiet = false, stage_snapshots = false;
+  long max_steps = kDefaultMaxSteps;
+  bool quiet = false, stage_snapshots = false, list_keys = false;
   SnapshotPrecision precision = SnapshotPrecision::Float32;
 };
 
@@ -66,7 +73,7 @@ int parse(int argc, char** argv, const char* tool, Args& a) {
     };
     std::string v;
     if (o == "--out" || o == "--cache" || o == "--relaxed-bed" || o == "--snapshot" || o == "--checkpoint" || o == "--set" ||
-        o == "--threads" || o == "--snapshot-precision" || o == "--profile") {
+        o == "--threads" || o == "--snapshot-precision" || o == "--profile" || o == "--max-steps") {
       if (!value(v)) return 2;
       if (o == "--out") a.out = v;
       else if (o == "--cache") a.cache = v;
@@ -75,6 +82,16 @@ int parse(int argc, char** argv, const char* tool, Args& a) {
       else if (o == "--checkpoint") a.checkpoint = v;
       else if (o == "--set") a.overrides.push_back(v);
       else if (o == "--profile") a.profile = v;
+      else if (o == "--max-steps") {
+        char* end = nullptr;
+        errno = 0;
+        const double n = std::strtod(v.c_str(), &end);
+        if (v.empty() || *end || errno || !(n >= 1 && n <= 1e15) || n != std::floor(n)) {
+          std::fprintf(stderr, "%s: --max-steps '%s': expected a whole number in [1, 1e15]\n", tool, v.c_str());
+          return 2;
+        }
+        a.max_steps = long(n);
+      }
       else if (o == "--snapshot-precision") {
         if (v != "32" && v != "64") {
           std::fprintf(stderr, "%s: --snapshot-precision '%s': expected 32 or 64\n", tool, v.c_str());
@@ -92,6 +109,8 @@ int parse(int argc, char** argv, const char* tool, Args& a) {
       }
     } else if (o == "--quiet") {
       a.quiet = true;
+    } else if (o == "--list-keys") {
+      a.list_keys = true;
     } else if (o == "--stage-snapshots") {
       a.stage_snapshots = true;
     } else if (o == "-h" || o == "--help") {
@@ -166,6 +185,27 @@ int run_cli(int argc, char** argv, const char* tool) {
       o.insert(o.end(), a.overrides.begin(), a.overrides.end());
       a.overrides = std::move(o);
     }
+    if (a.list_keys) {
+      // Keys are noted as the readers ask for them, present or not; a scene
+      // refused for its own values still lists the keys read before the error.
+      KeyLog log;
+      SceneOptions so;
+      so.cache_dir = a.cache;
+      so.quiet = true;
+      so.max_steps = a.max_steps;
+      std::string error;
+      try {
+        load_scene(a.file, a.overrides, so);
+      } catch (const InputError& e) {
+        error = e.what();
+      }
+      for (const KeyUse& k : log.keys()) std::printf("%s %s\n", k.path.c_str(), k.kind.c_str());
+      if (!error.empty()) {
+        std::fprintf(stderr, "%s: error: %s\n", tool, error.c_str());
+        return 2;
+      }
+      return 0;
+    }
     if (a.out.empty()) a.out = "out/" + load_document(a.file, a.overrides)["name"].as<std::string>("scenario");
     const OutputFolder out_folder(a.out);  // refused at once if in use or not writable
     if (!a.snapshot.empty()) check_writable(a.snapshot);
@@ -175,7 +215,21 @@ int run_cli(int argc, char** argv, const char* tool) {
     so.relaxed_bed = a.relaxed_bed;
     so.quiet = a.quiet;
     so.relax_out = a.out + "/bed_relax";
-    std::unique_ptr<Scene> scene = load_scene(a.file, a.overrides, so);
+    so.max_steps = a.max_steps;
+    std::unique_ptr<Scene> scene;
+    try {
+      scene = load_scene(a.file, a.overrides, so);
+    } catch (const BlowUpError& e) {
+      // A preparation run (a bed relaxation) that stopped: the folder still
+      // gets a summary saying so, as a run that stops does.
+      JsonObject j;
+      j.str("status", dynamic_cast<const StepLimitError*>(&e) ? "step_limit" : "blow_up")
+          .str("stage", "preparation")
+          .str("file", a.file)
+          .str("message", e.what());
+      j.write(a.out + "/summary.json");
+      throw;
+    }
     Model m = scene->sc.model;
     State s = scene->start;
     SceneRunOptions ro;
@@ -183,6 +237,7 @@ int run_cli(int argc, char** argv, const char* tool) {
     ro.progress_every = a.quiet ? 0 : 2.0;
     ro.stage_snapshots = a.stage_snapshots;
     ro.threads = threads;
+    ro.max_steps = a.max_steps;
     std::unique_ptr<SceneRun> run;
     const RunReport rep = run_scene(*scene, m, s, ro, &run);
     if (rep.status != "ok") {

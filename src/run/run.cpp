@@ -33,8 +33,10 @@ GrainSpeeds grain_speeds(const Model& m, const State& s, const std::vector<uint8
 }
 
 std::string clock_text(double seconds) {
+  // A rate near zero or an estimate of years is not a clock time.
+  if (!(seconds < 100 * 86400.0)) return "> 100 days";
   char b[32];
-  const long s = long(seconds + 0.5);
+  const long s = long(std::max(seconds, 0.0) + 0.5);
   if (s >= 3600)
     std::snprintf(b, sizeof b, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
   else
@@ -82,7 +84,28 @@ const std::vector<uint8_t>& Run::held() const { return held_->held(); }
 
 bool Run::ended() { return !settle(); }
 
+// Steps the stages' durations need at their time steps (a stage that scales
+// k_n runs at the scene's dt / sqrt(scale)); open-ended stages count nothing.
+static double planned_steps(const RunPlan& plan, const Model& m) {
+  double n = 0;
+  for (const Stage& st : plan.stages) {
+    if (!std::isfinite(st.duration)) continue;
+    const double dt = st.stiffness_scale > 0 && plan.scene_dt > 0 ? plan.scene_dt / std::sqrt(st.stiffness_scale) : m.dt;
+    n += st.duration / dt;
+  }
+  return n;
+}
+
 void Run::start() {
+  if (!(opt_.max_steps >= 1)) throw InputError("run '" + plan_.name + "': the step limit must be at least 1");
+  if (const double n = planned_steps(plan_, m_); n > double(opt_.max_steps)) {
+    char b[256];
+    std::snprintf(b, sizeof b, "the stages' durations need %.3g steps at dt = %.3g s, more than the limit of %ld",
+                  n, m_.dt, opt_.max_steps);
+    throw InputError("run '" + plan_.name + "': " + b +
+                     ": shorten the durations or raise dt (contact.steps_per_contact), or raise the limit "
+                     "(--max-steps; the node's ~max_steps) if the run is meant to be this long");
+  }
   started_ = true;
   t0_ = last_progress_ = Clock::now();
   t_start_ = rate_t_ = s_.time;
@@ -160,6 +183,12 @@ bool Run::advance() {
     next_sample_ += opt_.sample_every;
   }
   if (s_.step == step0_ && s_.forces_valid) watch_energy();  // the energy guard's first reference
+  if (s_.step - step0_ >= opt_.max_steps) {
+    char b[160];
+    std::snprintf(b, sizeof b, "the run reached its limit of %ld steps at t = %.6g s", opt_.max_steps, s_.time);
+    throw StepLimitError(std::string(b) + " (raise it with --max-steps, the node's ~max_steps, if the run is meant to be "
+                                          "this long)");
+  }
   step(m_, s_);
   rep_.max_overlap_ratio = std::max(rep_.max_overlap_ratio, s_.stats.max_overlap_ratio);
   for (Fix* f : fixes_) f->after_step(st, m_, s_);
@@ -328,6 +357,10 @@ RunReport Run::run() {
   try {
     while (advance()) {
     }
+  } catch (const StepLimitError& e) {
+    rep_.status = "step_limit";
+    rep_.message = e.what();
+    ended_ = true;
   } catch (const BlowUpError& e) {
     rep_.status = "blow_up";
     rep_.message = e.what();

@@ -141,6 +141,7 @@ RunReport run_scenario(Scenario& sc, State& s, const RunOptions& opt_in, int thr
   Run run(sc.model, s, RunPlan::of(sc), opt);
   ScenarioRun sr(scene, run);
   sr.attach(run);
+  if (!opt.out_dir.empty()) sr.remove_earlier_outputs(opt.out_dir);
   const RunReport rep = run.run();
   sc.groups = run.groups();
   if (!opt.out_dir.empty()) {

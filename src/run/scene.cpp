@@ -3,11 +3,17 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <mutex>
 
 #include "regolith_twin/run/scenario_kind.hpp"
+#include "regolith_twin/run/series.hpp"
 
 namespace rt {
 namespace {
@@ -156,9 +162,11 @@ RunReport run_scene(const Scene& scene, Model& m, State& s, const SceneRunOption
   ro.sample_every = scene.sample_every;
   ro.progress_every = opt.progress_every;
   ro.stage_snapshots = opt.stage_snapshots;
+  ro.max_steps = opt.max_steps;
   Run run(m, s, scene.plan, ro);
   std::unique_ptr<SceneRun> sr = scene.begin(run);
   sr->attach(run);
+  if (!opt.out_dir.empty()) sr->remove_earlier_outputs(opt.out_dir);
   const RunReport rep = run.run();
   if (!opt.out_dir.empty()) {
     sr->write_files(opt.out_dir, m, s, rep);
@@ -166,6 +174,58 @@ RunReport run_scene(const Scene& scene, Model& m, State& s, const SceneRunOption
   }
   if (out_run) *out_run = std::move(sr);
   return rep;
+}
+
+void SceneRun::remove_earlier_outputs(const std::string& dir) const {
+  make_dirs(dir);
+  for (const auto& [label, name] : files()) {
+    const std::string path = dir + "/" + name;
+    if (std::remove(path.c_str()) != 0 && errno != ENOENT)
+      throw InputError(path + ": cannot remove the " + label + " of an earlier run (" + std::strerror(errno) +
+                       "): remove it, or give another output folder");
+  }
+}
+
+void check_container(const Model& m, const std::string& file, const std::string& block, double rim,
+                     double container_radius, int body) {
+  double rmax = 0;
+  for (int i = 0; i < m.n_grains; ++i) rmax = std::max(rmax, m.grain_radius[i]);
+  char b[320];
+  const auto fail = [&](const std::string& key, const char* what) {
+    throw InputError(file + ": key '" + block + "." + key + "': " + what);
+  };
+  if (std::isfinite(rim)) {
+    double floor = -std::numeric_limits<double>::infinity();
+    int floor_wall = -1;
+    for (size_t w = 0; w < m.walls.size(); ++w)
+      if (m.walls[w].type == WallType::Plane && m.walls[w].axis.z() > 0.99 && m.walls[w].origin.z() > floor) {
+        floor = m.walls[w].origin.z();
+        floor_wall = int(w);
+      }
+    if (floor_wall >= 0 && !(rim >= floor + 2 * rmax)) {
+      std::snprintf(b, sizeof b, "%.6g m is not a grain diameter (%.3g m) above the floor, walls[%d].point at z = %.6g m",
+                    rim, 2 * rmax, floor_wall, floor);
+      fail("rim", b);
+    }
+  }
+  if (!(container_radius > 2 * rmax)) {
+    std::snprintf(b, sizeof b, "%.6g m is not wider than a grain diameter (%.3g m)", container_radius, 2 * rmax);
+    fail("container_radius", b);
+  }
+  for (size_t w = 0; w < m.walls.size(); ++w) {
+    const Wall& c = m.walls[w];
+    if (c.type == WallType::Cylinder && c.inner && std::abs(c.axis.z()) > 0.99 &&
+        container_radius > c.radius * (1 + 1e-9)) {
+      std::snprintf(b, sizeof b, "%.6g m is wider than the container's wall, walls[%zu].radius = %.6g m",
+                    container_radius, w, c.radius);
+      fail("container_radius", b);
+    }
+  }
+  if (body >= 0 && !(m.bodies[body].bound_radius < container_radius)) {
+    std::snprintf(b, sizeof b, "%.6g m: the body '%s' (bounding radius %.4g m) does not fit in the container",
+                  container_radius, m.bodies[body].name.c_str(), m.bodies[body].bound_radius);
+    fail("container_radius", b);
+  }
 }
 
 std::string default_cache_dir() {

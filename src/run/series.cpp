@@ -93,6 +93,7 @@ OutputFolder::~OutputFolder() {
 }
 
 void check_writable(const std::string& path) {
+  check_regular_target(path, "this output");
   const std::string probe = temp_name(path) + ".probe";
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0) throw InputError(path + ": cannot be written (" + std::strerror(errno) + ")");

@@ -18,8 +18,23 @@ namespace rt {
 void StageEdits::stage_start(const Stage& st, Model& m, State& s, StageReport& rep) {
   if (st.trim) {  // every grain above the trim height goes (its centre, or its top with trim_tops)
     std::vector<uint8_t> drop(m.n_grains, 0);
-    for (int i = 0; i < m.n_grains; ++i)
-      drop[i] = s.pos[i].z() + (st.trim_tops ? m.grain_radius[i] : 0.0) > st.trim_above;
+    double lowest = 1e300;
+    for (int i = 0; i < m.n_grains; ++i) {
+      const double z = s.pos[i].z() + (st.trim_tops ? m.grain_radius[i] : 0.0);
+      drop[i] = z > st.trim_above;
+      lowest = std::min(lowest, z);
+    }
+    if (m.n_grains > 0 && std::find(drop.begin(), drop.end(), 0) == drop.end()) {
+      // Nothing would be left to measure: a trim plane below the bed is an input error.
+      const std::ptrdiff_t k = &st - plan_.stages.data();
+      const std::string key = k >= 0 && k < std::ptrdiff_t(plan_.stages.size())
+                                  ? "stages[" + std::to_string(k) + "].trim_above"
+                                  : "trim_above of stage '" + st.name + "'";
+      char b[200];
+      std::snprintf(b, sizeof b, " = %.6g m removes every grain (the lowest %s is at %.6g m): raise it", st.trim_above,
+                    st.trim_tops ? "grain top" : "grain centre", lowest);
+      throw InputError("key '" + key + "'" + b);
+    }
     rep.grains_removed = remove_grains(m, s, drop, plan_.groups);
   }
   if (st.stiffness_scale > 0 && plan_.scene_kn > 0) {

@@ -16,7 +16,7 @@ std::string vec_text(const Vec3& v) {
 }
 }  // namespace
 
-Twin::Twin(const TwinOptions& opt) : file_(opt.file) {
+Twin::Twin(const TwinOptions& opt) : file_(opt.file), max_steps_(opt.scene.max_steps) {
   scene_ = load_scene(opt.file, opt.overrides, opt.scene);
   reset();
 }
@@ -38,6 +38,7 @@ void Twin::restart_run() {
   scene_run_.reset();
   RunOptions ro;
   ro.progress_every = 0;
+  ro.max_steps = max_steps_;
   run_ = std::make_unique<Run>(model_, state_, scene_->plan, ro);
   scene_run_ = scene_->begin(*run_);
   scene_run_->attach(*run_);

@@ -370,6 +370,81 @@ TEST(TwinNodeServices, ABlockingCheckpointPathDoesNotStopTheNode) {
   EXPECT_TRUE(step(2).success);
 }
 
+TEST(TwinNodeServices, TwoPipeLoadsLeavePauseAnswered) {
+  // Two loads from pipes nobody writes: they wait on the node's I/O thread
+  // (until ~io_timeout), while pause, unpause and step answer at once.
+  char dir[] = "/tmp/regolith_fifo2_XXXXXX";
+  ASSERT_NE(mkdtemp(dir), nullptr);
+  const std::string a = std::string(dir) + "/a.ckpt", b = std::string(dir) + "/b.ckpt";
+  ASSERT_EQ(mkfifo(a.c_str(), 0600), 0);
+  ASSERT_EQ(mkfifo(b.c_str(), 0600), 0);
+  auto l1 = persistent_client<regolith_twin::Checkpoint>("load_checkpoint");
+  auto l2 = persistent_client<regolith_twin::Checkpoint>("load_checkpoint");
+  regolith_twin::Checkpoint c1, c2;
+  c1.request.path = a;
+  c2.request.path = b;
+  std::atomic<int> answered{0};
+  std::thread t1([&] { EXPECT_TRUE(l1.call(c1)); ++answered; });
+  std::thread t2([&] { EXPECT_TRUE(l2.call(c2)); ++answered; });
+  ros::WallDuration(0.3).sleep();
+  EXPECT_EQ(answered, 0) << "the loads wait for their pipes";
+  for (const char* name : {"unpause", "pause"}) {
+    const ros::WallTime t0 = ros::WallTime::now();
+    EXPECT_TRUE(trigger(name));
+    EXPECT_LT((ros::WallTime::now() - t0).toSec(), 1.0) << name << " answered while two loads wait";
+  }
+  const ros::WallTime t0 = ros::WallTime::now();
+  EXPECT_TRUE(step(3).success);
+  EXPECT_LT((ros::WallTime::now() - t0).toSec(), 1.0);
+  t1.join();
+  t2.join();
+  EXPECT_FALSE(c1.response.success);
+  EXPECT_FALSE(c2.response.success);
+  EXPECT_NE(c1.response.message.find("within"), std::string::npos) << c1.response.message;
+  std::remove(a.c_str());
+  std::remove(b.c_str());
+  rmdir(dir);
+}
+
+TEST(TwinNodeServices, CheckpointsStayInTheirDirectory) {
+  // ~checkpoint_dir is /tmp here: paths outside it, links out of it and
+  // targets that are not regular files are refused, naming the directory.
+  char dir[] = "/tmp/regolith_ckdir_XXXXXX";
+  ASSERT_NE(mkdtemp(dir), nullptr);
+  const std::string link = std::string(dir) + "/out", fifo = std::string(dir) + "/pipe.ckpt";
+  ASSERT_EQ(symlink("/var", link.c_str()), 0);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  regolith_twin::Checkpoint c;
+  for (const std::string& p : {std::string("/dev/full"), std::string("/etc/state.ckpt"), link + "/state.ckpt",
+                               std::string(dir) + "/../../etc/state.ckpt"}) {
+    c.request.path = p;
+    ASSERT_TRUE(ros::service::call(srv("save_checkpoint"), c));
+    EXPECT_FALSE(c.response.success) << p;
+    EXPECT_NE(c.response.message.find("checkpoints are kept in /tmp"), std::string::npos) << c.response.message;
+    ASSERT_TRUE(ros::service::call(srv("load_checkpoint"), c));
+    EXPECT_FALSE(c.response.success) << p;
+  }
+  c.request.path = fifo;
+  ASSERT_TRUE(ros::service::call(srv("save_checkpoint"), c));
+  EXPECT_FALSE(c.response.success);
+  EXPECT_NE(c.response.message.find("named pipe"), std::string::npos) << c.response.message;
+  struct stat st {};
+  ASSERT_EQ(stat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode)) << "the pipe is not replaced";
+  // A relative name is taken inside the directory.
+  const std::string name = std::string(dir + 5) + "/good.ckpt";  // dir without "/tmp/"
+  c.request.path = name;
+  ASSERT_TRUE(ros::service::call(srv("save_checkpoint"), c));
+  EXPECT_TRUE(c.response.success) << c.response.message;
+  EXPECT_EQ(access((std::string(dir) + "/good.ckpt").c_str(), R_OK), 0);
+  ASSERT_TRUE(ros::service::call(srv("load_checkpoint"), c));
+  EXPECT_TRUE(c.response.success) << c.response.message;
+  std::remove((std::string(dir) + "/good.ckpt").c_str());
+  std::remove(fifo.c_str());
+  std::remove(link.c_str());
+  rmdir(dir);
+}
+
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "twin_node_services_test");
@@ -386,6 +461,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   g_params.start_paused = true;
+  g_params.io_timeout = 2;  // the pipe loads above give up after 2 s
   g_params.threads = 1;
   g_params.body_state_rate = 0;
   ros::Subscriber sub = pnh.subscribe("body_states", 1000, on_states);

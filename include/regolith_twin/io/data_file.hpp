@@ -44,9 +44,27 @@ void check_file_size(const std::string& path, std::size_t max_bytes, const std::
 // it cannot be opened.
 std::string read_file_limited(const std::string& path, std::size_t max_bytes, const std::string& what);
 
+// `path` (relative: taken from `dir`) when it lies inside `dir` once every
+// link is followed, else an InputError naming both and what to do (a path
+// outside, or a link out of the directory). `dir` is created if missing.
+// Used for the node's checkpoints (~checkpoint_dir; docs/ros.md).
+std::string path_inside(const std::string& dir, const std::string& path, const std::string& what);
+
+// read_file_limited for a file that may be a named pipe: a regular file is
+// read whole; a pipe is read until its writer closes it or `timeout` seconds
+// pass (an InputError then), so a pipe nobody writes cannot hold the reader
+// for ever; any other kind of file (a device, a directory) is refused.
+std::string read_file_bounded(const std::string& path, std::size_t max_bytes, const std::string& what,
+                              double timeout);
+
 // A temporary name beside `path`, unique to this process (written, then
 // renamed over `path`).
 std::string temp_name(const std::string& path);
+
+// A target that exists and is not a regular file (a device such as
+// /dev/full, a pipe, a directory) is refused with an InputError naming it:
+// the rename would replace it. Called by write_file_replacing and check_writable.
+void check_regular_target(const std::string& path, const std::string& what);
 
 // Write `bytes` to temp_name(path) (flushed to the disk first when `sync`),
 // then rename it over `path`: a writer killed or stopped by a full disk

@@ -105,6 +105,10 @@ int remove_grains(Model& m, State& s, const std::vector<uint8_t>& drop, std::vec
                   std::vector<int>* old_to_new = nullptr);
 
 // Published materials (docs/model.md §9): gravel, moderate, glass_beads, glass_beads_b.
+// "bodies[0].name = 'a', bodies[1].name = 'b'": the bodies a kind's key may
+// name, for its message when it names none of them.
+std::string body_names_text(const Model& m);
+
 bool material_preset(const std::string& name, Material& out);
 
 }  // namespace rt

@@ -17,6 +17,48 @@
 
 namespace rt {
 
+// The keys the readers ask for while a scene file is read on this thread,
+// with what each expects: installed by `regolith_sim --list-keys`, which the
+// input fuzzer (test/fuzz/input_fuzz.py) reads, so a new key is fuzzed
+// without editing the test. Nested logs restore the outer one.
+struct KeyUse {
+  std::string path;  // dotted, list entries as [i]: walls[0].radius
+  std::string kind;  // number, integer, bool, text, choice, vector, map
+};
+
+class KeyLog {
+ public:
+  KeyLog() : outer_(current()) { current() = this; }
+  ~KeyLog() { current() = outer_; }
+  KeyLog(const KeyLog&) = delete;
+  KeyLog& operator=(const KeyLog&) = delete;
+  static void note(const std::string& path, const char* kind) {
+    KeyLog* l = current();
+    if (!l) return;
+    for (const KeyUse& k : l->keys_)
+      if (k.path == path) return;
+    l->keys_.push_back({path, kind});
+  }
+  const std::vector<KeyUse>& keys() const { return keys_; }
+
+ private:
+  static KeyLog*& current() {
+    static thread_local KeyLog* log = nullptr;
+    return log;
+  }
+  KeyLog* outer_;
+  std::vector<KeyUse> keys_;
+};
+
+
+// Physical bounds of scene-file values (docs/scenes.md, "Input ranges"): far
+// beyond any scene, yet small enough that their products stay finite and a
+// run stays meaningful. A key with no narrower range of its own has these.
+constexpr double kMaxSceneLength = 1e4;    // m: coordinates, sizes, distances
+constexpr double kMaxSceneMass = 1e6;      // kg
+constexpr double kMaxSceneStiffness = 1e12;  // N/m
+constexpr double kMaxSceneDuration = 1e6;  // s
+constexpr double kMaxSceneSpeed = 1e5;     // m/s (also m/s^2 for accelerations in vectors)
 
 class YamlReader {
  public:
@@ -39,12 +81,14 @@ class YamlReader {
   }
 
   double number(const YAML::Node& node, const std::string& path, double lo, double hi, bool lo_open = false) const {
+    KeyLog::note(path, "number");
     double v = 0;
     try {
       v = node.as<double>();
     } catch (const YAML::Exception&) {
       fail(path, "expected a number" + range_text(lo, hi, lo_open) + ", got '" + scalar_text(node) + "'");
     }
+    if (!std::isfinite(v) && lo == -kInf && hi == kInf) fail(path, "value " + scalar_text(node) + " is not a finite number");
     if (!std::isfinite(v) || (lo_open ? !(v > lo) : !(v >= lo)) || !(v <= hi))
       fail(path, "value " + scalar_text(node) + " out of range (allowed" + range_text(lo, hi, lo_open) + ")");
     return v;
@@ -52,6 +96,7 @@ class YamlReader {
 
   double number(const YAML::Node& map, const std::string& path, const std::string& key, double dflt, double lo,
                 double hi, bool lo_open = false) const {
+    KeyLog::note(join(path, key), "number");
     const YAML::Node n = get(map, key);
     if (!n) return dflt;
     return number(n, join(path, key), lo, hi, lo_open);
@@ -59,6 +104,7 @@ class YamlReader {
 
   long integer(const YAML::Node& map, const std::string& path, const std::string& key, long dflt, long lo,
                long hi) const {
+    KeyLog::note(join(path, key), "integer");
     const YAML::Node n = get(map, key);
     if (!n) return dflt;
     long v = 0;
@@ -75,6 +121,7 @@ class YamlReader {
   }
 
   bool boolean(const YAML::Node& map, const std::string& path, const std::string& key, bool dflt) const {
+    KeyLog::note(join(path, key), "bool");
     const YAML::Node n = get(map, key);
     if (!n) return dflt;
     try {
@@ -86,6 +133,7 @@ class YamlReader {
 
   std::string text(const YAML::Node& map, const std::string& path, const std::string& key,
                    const std::string& dflt) const {
+    KeyLog::note(join(path, key), "text");
     const YAML::Node n = get(map, key);
     if (!n) return dflt;
     if (!n.IsScalar()) fail(join(path, key), "expected a string");
@@ -94,6 +142,7 @@ class YamlReader {
 
   std::string choice(const YAML::Node& map, const std::string& path, const std::string& key,
                      const std::string& dflt, const std::vector<std::string>& allowed) const {
+    KeyLog::note(join(path, key), "choice");
     const std::string v = text(map, path, key, dflt);
     for (const auto& a : allowed)
       if (v == a) return v;
@@ -104,6 +153,7 @@ class YamlReader {
 
   Vec3 vec3(const YAML::Node& map, const std::string& path, const std::string& key, const Vec3& dflt,
             bool required = false) const {
+    KeyLog::note(join(path, key), "vector");
     const YAML::Node n = get(map, key);
     if (!n) {
       if (required) fail(join(path, key), "missing (expected [x, y, z])");
@@ -111,12 +161,15 @@ class YamlReader {
     }
     if (!n.IsSequence() || n.size() != 3) fail(join(path, key), "expected a list of three numbers [x, y, z]");
     Vec3 v;
+    // Positions, directions, velocities, gravity, inertias: each component
+    // within +-kMaxSceneLength (1e4), which holds every one of them.
     for (int i = 0; i < 3; ++i)
-      v[i] = number(n[i], join(path, key) + "[" + std::to_string(i) + "]", -kInf, kInf);
+      v[i] = number(n[i], join(path, key) + "[" + std::to_string(i) + "]", -kMaxSceneLength, kMaxSceneLength);
     return v;
   }
 
   YAML::Node map(const YAML::Node& parent, const std::string& path, const std::string& key, bool required) const {
+    KeyLog::note(join(path, key), "map");
     const YAML::Node n = get(parent, key);
     if (!n) {
       if (required) fail(join(path, key), "missing");
@@ -157,7 +210,7 @@ class YamlReader {
     return os.str();
   }
   static std::string range_text(double lo, double hi, bool lo_open) {
-    if (lo == -kInf && hi == kInf) return "";
+    if (lo == -kInf && hi == kInf) return " (any finite number)";
     std::string s = " ";
     if (hi == kInf) return s + (lo_open ? "> " : ">= ") + num_text(lo);
     if (lo == -kInf) return s + "<= " + num_text(hi);

@@ -6,6 +6,7 @@
 // callbacks take the same lock, so a request always sees a whole step.
 #pragma once
 
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
@@ -52,7 +53,15 @@ struct NodeParams {
                                       //   ~status have a subscriber (a rosbag recorder) and 1 s has passed
   int threads = 0;                    // ~threads: OpenMP threads (0: all cores)
   double max_step_wall = 600;         // ~max_step_wall: wall seconds a ~step request may take before it is stopped
+  std::string checkpoint_dir;         // ~checkpoint_dir: where ~save_checkpoint and ~load_checkpoint paths must lie
+                                      //   ("" : <out_dir>/checkpoints, else $ROS_HOME or ~/.ros + /regolith_twin/checkpoints)
+  double io_timeout = 30;             // ~io_timeout: wall seconds a checkpoint load waits for a pipe's data
+  long max_steps = 0;                 // ~max_steps: steps a run may take (0: no limit; the node is stepped,
+                                      //   paused and cancelled from outside)
 };
+
+// The checkpoint directory the node uses for p (created if missing).
+std::string checkpoint_dir(const NodeParams& p);
 
 // Throws std::invalid_argument naming the parameter and its allowed range.
 NodeParams read_params(const ros::NodeHandle& pnh);
@@ -98,6 +107,12 @@ class TwinNode {
 
   ros::NodeHandle nh_, pnh_;
   NodeParams p_;
+  std::string checkpoint_dir_;
+  // Checkpoint saves and loads are served from their own queue and thread:
+  // a slow file or a pipe nobody writes never holds the threads that answer
+  // pause, unpause, reset and step (docs/ros.md).
+  ros::CallbackQueue io_queue_;
+  std::unique_ptr<ros::AsyncSpinner> io_spinner_;
   std::unique_ptr<rt::OutputFolder> out_folder_;  // ~out_dir, held for the node's life
   std::unique_ptr<rt::Twin> twin_;
   std::unique_ptr<SceneTopics> topics_;  // the scene kind's own topics

@@ -50,11 +50,18 @@ struct RunPlan {
   static RunPlan open_ended(const std::string& name, const std::string& stage = "run");
 };
 
+// Steps a run may take unless raised (--max-steps, the node's ~max_steps):
+// ten times the longest shipped run, so a time step or duration that would
+// run for days is refused at the start instead of found out later.
+constexpr long kDefaultMaxSteps = 100000000;
+
 struct RunOptions {
   std::string out_dir;          // series.csv (and stage snapshots) written here; empty: nothing written
   double sample_every = 0.01;   // s of simulated time between series rows
   double progress_every = 2.0;  // wall seconds between progress lines (<= 0: none)
   bool stage_snapshots = false; // write out_dir/<stage>.bed (compact snapshot) after every stage
+  long max_steps = kDefaultMaxSteps;  // stages whose durations need more are refused at the start
+                                      // (InputError); a run past it stops with status step_limit
 };
 
 struct StageReport {
@@ -67,7 +74,7 @@ struct StageReport {
 };
 
 struct RunReport {
-  std::string status = "ok";  // ok | blow_up
+  std::string status = "ok";  // ok | blow_up | step_limit
   std::string message;        // diagnostic when not ok
   long steps = 0;             // taken by this run
   long rebuilds = 0;          // neighbour-list rebuilds in this run (grain lists; body lists apart)

@@ -26,6 +26,7 @@ struct SceneOptions {
   bool quiet = false;      // no progress lines while preparing
   std::string relaxed_bed; // a relaxed bed to start from instead of relaxing or the cache (a checkpoint of
                            // the same grains, e.g. a cache file of a run at another time step)
+  long max_steps = kDefaultMaxSteps;  // of a bed relaxation (RunOptions::max_steps)
 };
 
 class JsonObject;
@@ -62,6 +63,10 @@ class SceneRun {
   virtual std::vector<std::pair<std::string, std::string>> files() const {
     return {{"summary", "summary.json"}, {"time series", "series.csv"}};
   }
+  // Every file of files() removed from dir (created if missing): a run
+  // killed before its end leaves no earlier run's outputs beside its own
+  // partial ones (docs/files.md, outputs). run_scene calls it before the first step.
+  void remove_earlier_outputs(const std::string& dir) const;
   // One line on the outcome, for the command line and the node's log.
   virtual std::string result_line(const Model& m, const State& s, const RunReport& rep) const = 0;
 
@@ -129,6 +134,7 @@ struct SceneRunOptions {
   double progress_every = 2.0;  // wall seconds between progress lines (<= 0: none)
   bool stage_snapshots = false; // out_dir/<stage>.bed after every stage
   int threads = 0;              // recorded in the summary
+  long max_steps = kDefaultMaxSteps;  // RunOptions::max_steps
 };
 
 // Run a prepared scene from state s (initially scene.start) to its end on
@@ -137,6 +143,15 @@ struct SceneRunOptions {
 // callers that read its observers afterwards.
 RunReport run_scene(const Scene& scene, Model& m, State& s, const SceneRunOptions& opt,
                     std::unique_ptr<SceneRun>* run = nullptr);
+
+// A kind's container keys checked against the geometry they describe
+// (docs/scenes.md, "Input ranges"): `block`.rim (skipped when NaN) at least a
+// grain diameter above the floor (the highest upward plane wall), and
+// `block`.container_radius wider than a grain diameter, within the scene's
+// vertical cylinder wall if it has one, and wider than `body`'s bounding
+// sphere (skipped when body < 0). Throws InputError naming the keys.
+void check_container(const Model& m, const std::string& file, const std::string& block, double rim,
+                     double container_radius, int body);
 
 // $REGOLITH_CACHE, else ~/.cache/regolith_twin.
 std::string default_cache_dir();

@@ -76,6 +76,7 @@ class Twin {
  private:
   void restart_run();
   std::string file_;
+  long max_steps_ = kDefaultMaxSteps;  // of each run (TwinOptions::scene.max_steps)
   std::unique_ptr<Scene> scene_;
   Model model_;
   State state_;

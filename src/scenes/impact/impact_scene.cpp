@@ -229,7 +229,7 @@ std::unique_ptr<Scene> ImpactKind::prepare(const YAML::Node& doc, const std::str
   for (const auto& w : sc.warnings) std::fprintf(stderr, "[impact] warning: %s\n", w.c_str());
   for (size_t k = 0; k < m.bodies.size(); ++k)
     if (m.bodies[k].name == sp.impactor) is->body = int(k);
-  if (is->body < 0) rd.fail("impact.impactor", "no body named '" + sp.impactor + "' under 'bodies'");
+  if (is->body < 0) rd.fail("impact.impactor", "no body named '" + sp.impactor + "' (" + body_names_text(is->sc.model) + ")");
   const BodyModel& bm = m.bodies[is->body];
   if (bm.fixed || bm.shapes.size() != 1 || bm.shapes[0].type != ShapeType::Sphere)
     rd.fail("impact.impactor", "the impactor must be a free body of one sphere shape");

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <sstream>
 
@@ -40,14 +41,16 @@ InclineSpec parse_incline(const YAML::Node& n, const std::string& src) {
   sp.rain = mode == "rain";
   sp.angle_deg = rd.number(n, p, "angle_deg", sp.angle_deg, 0, 89);
   sp.start_deg = rd.number(n, p, "start_deg", sp.start_deg, 0, 89);
-  sp.step_deg = rd.number(n, p, "step_deg", sp.step_deg, 0, 10, true);
+  sp.step_deg = rd.number(n, p, "step_deg", sp.step_deg, 0.01, 10);
   sp.max_deg = rd.number(n, p, "max_deg", sp.max_deg, sp.start_deg, 89);
-  sp.hold = rd.number(n, p, "hold", sp.hold, 0, 1e3, true);
+  sp.hold = rd.number(n, p, "hold", sp.hold, 1e-3, 1e3);  // s: a step must last some steps
   sp.flow_speed = rd.number(n, p, "flow_speed", sp.flow_speed, 0, 10, true);
-  sp.duration = rd.number(n, p, "duration", sp.duration, 0, 1e4, true);
-  sp.average = rd.number(n, p, "average", sp.average, 0, sp.duration, true);
-  sp.layer = rd.number(n, p, "layer", sp.layer, 0, 1, true);
-  sp.sample_every = rd.number(n, p, "sample_every", sp.sample_every, 0, 1e3, true);
+  sp.duration = rd.number(n, p, "duration", sp.duration, 1e-3, 1e4);
+  sp.average = rd.number(n, p, "average", sp.average, 0, 1e4, true);
+  if (sp.average > sp.duration)
+    rd.fail(p + ".average", "the averaging window is longer than the run (" + p + ".duration): shorten it or lengthen the run");
+  sp.layer = rd.number(n, p, "layer", sp.layer, 1e-4, 1);  // m: profiles of at most ~1e4 layers
+  sp.sample_every = rd.number(n, p, "sample_every", sp.sample_every, 1e-6, 1e3);
   sp.rest_speed = rd.number(n, p, "rest_speed", sp.rest_speed, 0, 10);
   sp.rest_hold = rd.number(n, p, "rest_hold", sp.rest_hold, 0, sp.duration, true);
   if (sp.rest_speed > 0 && mode != "rain") rd.fail(p + ".rest_speed", "applies to mode rain only");
@@ -273,7 +276,7 @@ void InclineObserver::finish(const Model& m, const State& s) {
   p.bagnold_a = bagnold_amplitude(p.z, p.vx, p.height, &p.fit_rms);
   p.inertial_number = p.packing_mean > 0 ? bagnold_inertial_number(p.bagnold_a, d_, p.height, p.packing_mean, g_,
                                                                     theta_deg_ * kPi / 180)
-                                         : 0;
+                                         : std::numeric_limits<double>::quiet_NaN();  // undefined: null in the summary
 }
 
 void InclineObserver::columns(std::vector<std::string>& out) const {

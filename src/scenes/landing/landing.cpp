@@ -94,7 +94,7 @@ LandingSpec interpret_landing(const YAML::Node& n, const std::string& src) {
     sp.aim = Vec3(rd.number(aim[0], p + ".aim[0]", -1e3, 1e3), rd.number(aim[1], p + ".aim[1]", -1e3, 1e3), 0);
   }
   sp.slope_deg = rd.number(n, p, "slope_deg", sp.slope_deg, -60, 60);
-  sp.g = rd.number(n, p, "g", sp.g, 0, 100);
+  sp.g = rd.number(n, p, "g", sp.g, 1e-6, 100);  // m/s^2: Ryugu 1.2e-4; the hop figures need g > 0
   sp.after_liftoff = rd.number(n, p, "after_liftoff", sp.after_liftoff, 0, 1e4);
   sp.max_after_contact = rd.number(n, p, "max_after_contact", sp.max_after_contact, 0, 1e5);
   sp.max_time = rd.number(n, p, "max_time", sp.max_time, 0, 1e6);

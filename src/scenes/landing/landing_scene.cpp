@@ -100,8 +100,9 @@ std::unique_ptr<Scene> LandingKind::prepare(const YAML::Node& doc, const std::st
   for (size_t k = 0; k < m.bodies.size(); ++k)
     if (m.bodies[k].name == ls->spec.lander) ls->lander = int(k);
   if (ls->lander < 0)
-    throw InputError(file + ": key 'landing.lander': no body named '" + ls->spec.lander + "' under 'bodies'");
+    throw InputError(file + ": key 'landing.lander': no body named '" + ls->spec.lander + "' (" + body_names_text(m) + ")");
   const int b = ls->lander;
+  check_container(m, file, "landing", ls->spec.rim, ls->spec.container_radius, b);
   m.gravity = landing_gravity(ls->spec);
   for (const auto& w : sc.warnings) std::fprintf(stderr, "[landing] warning: %s\n", w.c_str());
   if (!opt.quiet) {

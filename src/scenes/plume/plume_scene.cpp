@@ -169,6 +169,14 @@ std::string PlumeRun::result_line(const Model& m, const State& s, const RunRepor
   return b;
 }
 
+// "materials.a, materials.b": the materials of the scene's grains, for messages.
+static std::string material_keys(const Scenario& sc) {
+  std::string t;
+  for (const Material& mat : sc.model.materials)
+    if (!mat.structure) t += (t.empty() ? "" : ", ") + std::string("materials.") + mat.name;
+  return t;
+}
+
 std::unique_ptr<Scene> PlumeKind::prepare(const YAML::Node& doc, const std::string& file,
                                           const SceneOptions& opt) const {
   auto ps = std::make_unique<PlumeScene>();
@@ -197,6 +205,8 @@ std::unique_ptr<Scene> PlumeKind::prepare(const YAML::Node& doc, const std::stri
   ps->sc = parse_scenario(root, file);
   Scenario& sc = ps->sc;
   Model& m = sc.model;
+  if (!(m.gravity.norm() >= 1e-6))
+    rd.fail("gravity", "the plume's figures are ratios to the grains' weight: gravity must be at least 1e-6 m/s^2");
   for (const auto& w : sc.warnings) std::fprintf(stderr, "[plume] warning: %s\n", w.c_str());
   const GasField* gas = gas_of(m);
   if (!gas && !sp.splash) rd.fail("gas", "the plume scene needs a gas (or plume.splash for the test without one)");
@@ -237,7 +247,9 @@ std::unique_ptr<Scene> PlumeKind::prepare(const YAML::Node& doc, const std::stri
   ps->bed_fraction = hi > lo ? vol / (area * (hi - lo)) : 0;
   if (!(ps->bed_fraction > 0.05))
     throw InputError(file + ": the settled bed is too shallow to measure its solid fraction (top " +
-                     std::to_string(top / d) + " d above the floor; at least 5 d needed)");
+                     std::to_string(top / d) + " d above the floor; at least 5 d needed): its depth comes from the "
+                     "grains (grains[0].fill, grains[0].radius), their material (" + material_keys(sc) +
+                     "), the box (periodic.x, periodic.y), gravity and the seed");
 
   // 3. The planes and the gas, anchored to the state's first field value.
   ErosionPlanes& pl = ps->planes;

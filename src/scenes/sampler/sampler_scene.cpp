@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <random>
 
@@ -164,16 +165,16 @@ SamplerSpec parse_sampler(const YAML::Node& n, const std::string& src) {
   sp.speed = rd.number(n, p, "speed", sp.speed, 1, 1e4, true);
   sp.tilt_deg = rd.number(n, p, "tilt_deg", sp.tilt_deg, -25, 25);
   sp.offset = rd.number(n, p, "offset", sp.offset, -2.5e-3, 2.5e-3);
-  sp.mass = rd.number(n, p, "mass", sp.mass, 0, 1e3, true);
-  sp.radius = rd.number(n, p, "radius", sp.radius, 0, 1, true);
+  sp.mass = rd.number(n, p, "mass", sp.mass, 1e-6, 1e3);
+  sp.radius = rd.number(n, p, "radius", sp.radius, 1e-5, 1);
   sp.start_gap = rd.number(n, p, "start_gap", sp.start_gap, 0, 1);
   sp.horn_clearance = rd.number(n, p, "horn_clearance", sp.horn_clearance, 0, 1);
   sp.container_radius = rd.number(n, p, "container_radius", sp.container_radius, 0, 1e3, true);
   sp.duration = rd.number(n, p, "duration", sp.duration, 0, 1e4, true);
-  sp.kn_ref = rd.number(n, p, "kn_ref", sp.kn_ref, 0, 1e15, true);
-  sp.dt_ref = rd.number(n, p, "dt_ref", sp.dt_ref, 0, 1, true);
-  sp.v_ref = rd.number(n, p, "v_ref", sp.v_ref, 0, 1e5, true);
-  sp.dt_factor = rd.number(n, p, "dt_factor", sp.dt_factor, 0, 1, true);
+  sp.kn_ref = rd.number(n, p, "kn_ref", sp.kn_ref, 1e-3, 1e15);
+  sp.dt_ref = rd.number(n, p, "dt_ref", sp.dt_ref, 1e-12, 1);
+  sp.v_ref = rd.number(n, p, "v_ref", sp.v_ref, 1e-3, 1e5);
+  sp.dt_factor = rd.number(n, p, "dt_factor", sp.dt_factor, 1e-3, 1);
   sp.sample_every = rd.number(n, p, "sample_every", sp.sample_every, 1e-7, 1e3);
   sp.escape_half_width = rd.number(n, p, "escape_half_width", sp.escape_half_width, 0, 1e3, true);
   sp.escape_height = rd.number(n, p, "escape_height", sp.escape_height, 0, 1e3, true);
@@ -222,7 +223,10 @@ std::unique_ptr<Scene> SamplerKind::prepare(const YAML::Node& doc, const std::st
   Model& m = sc.model;
   for (size_t k = 0; k < m.bodies.size(); ++k)
     if (m.bodies[k].name == sp.horn) ss->horn = int(k);
-  if (ss->horn < 0) throw InputError(file + ": key 'sampler.horn': no body named '" + sp.horn + "' under 'bodies'");
+  if (ss->horn < 0) throw InputError(file + ": key 'sampler.horn': no body named '" + sp.horn + "' (" + body_names_text(ss->sc.model) + ")");
+  check_container(m, file, "sampler", std::numeric_limits<double>::quiet_NaN(), sp.container_radius, -1);
+  if (!(m.gravity.norm() >= 1e-6))
+    throw InputError(file + ": key 'gravity': the ejecta's flight figures need gravity of at least 1e-6 m/s^2");
   if (!m.bodies[ss->horn].fixed)
     throw InputError(file + ": key 'sampler.horn': the horn body '" + sp.horn + "' must be fixed (fixed: true)");
   int proj_mat = -1;

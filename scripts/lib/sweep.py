@@ -362,6 +362,32 @@ def run_one(a, land, point, bed, out_runs, index, total, eta_text):
     return rc, status, wall, summary
 
 
+def other_settings(a, p, d):
+    """'' when the finished run in d (if any) was made with this command's settings, else both settings."""
+    meta = read_json(os.path.join(d, "sweep_run.json"))
+    if not is_done(d) or meta is None:
+        return ""
+    want = run_overrides(a, p, bed_file(a.bed_dir, p[0], p[1]))
+    had = meta.get("overrides")
+    if meta.get("config") == a.config and had == want:
+        return ""
+    had = had if isinstance(had, list) else []
+    return (f"  {meta.get('config')} --set " + " --set ".join(str(x) for x in had) + f"\nnow:\n  {a.config} --set "
+            + " --set ".join(want))
+
+
+def check_writable_dir(path, what):
+    """Fail at once, naming the folder, when path cannot be created or written (not after the first run)."""
+    try:
+        os.makedirs(path, exist_ok=True)
+        probe = temp_name(os.path.join(path, ".probe"))
+        with open(probe, "w"):
+            pass
+        os.remove(probe)
+    except OSError as e:
+        fail(f"{path}: the {what} cannot be written ({e.strerror}); give another folder or fix its permissions")
+
+
 def sweep(a, grid, land):
     out_runs = os.path.join(a.out, "runs")
     os.makedirs(out_runs, exist_ok=True)
@@ -373,13 +399,9 @@ def sweep(a, grid, land):
     # Finished runs are only reused when they were made with the same settings.
     for p in grid:
         d = os.path.join(out_runs, run_name(*p))
-        meta = read_json(os.path.join(d, "sweep_run.json"))
-        if is_done(d) and meta is not None:
-            want = run_overrides(a, p, bed_file(a.bed_dir, p[0], p[1]))
-            if meta.get("config") != a.config or meta.get("overrides") != want:
-                fail(f"{d} was made with other settings:\n  {meta.get('config')} --set "
-                     + " --set ".join(meta.get("overrides", [])) + f"\nnow:\n  {a.config} --set "
-                     + " --set ".join(want) + "\nuse another --out, or remove that run folder to redo it")
+        other = other_settings(a, p, d)
+        if other:
+            fail(f"{d} was made with other settings:\n{other}\nuse another --out, or remove that run folder to redo it")
     # The grid of this command, for the report.
     write_json(os.path.join(a.out, "sweep.json"),
                dict(a.grid_lists, config=a.config, bed_dir=a.bed_dir, set=a.set, threads=a.threads,
@@ -873,7 +895,11 @@ def main(argv=None):
         for i, p in enumerate(grid, 1):
             d = os.path.join(a.out, "runs", run_name(*p))
             bed = "" if os.path.isfile(bed_file(a.bed_dir, p[0], p[1])) else " (bed missing)"
-            print(f"[{i}/{len(grid)}] {run_name(*p)}: {'done' if is_done(d) else 'to run'}{bed}")
+            state = "to run"
+            if is_done(d):
+                state = "done, with other settings: the sweep refuses it (use another --out, or remove the " \
+                        "folder)" if other_settings(a, p, d) else "done"
+            print(f"[{i}/{len(grid)}] {run_name(*p)}: {state}{bed}")
     missing = [(m, d) for m in mats for d in depths if not os.path.isfile(bed_file(a.bed_dir, m, d))]
     if missing:
         msg = ["bed snapshot(s) missing; prepare each once (hours on 2 cores) with:"]
@@ -893,6 +919,9 @@ def main(argv=None):
     if a.slurm and not shutil.which("sbatch"):
         fail("--slurm: sbatch not found (Slurm's client commands must be on PATH)")
 
+    check_writable_dir(a.out, "output folder")
+    if a.record:
+        check_writable_dir(a.record, "record folder (--record)")
     signal.signal(signal.SIGTERM, on_signal)
     t0 = time.time()
     try:

@@ -80,6 +80,18 @@ class SweepTest(unittest.TestCase):
         p = self.sweep("--set", "landing.speed=0.1")
         self.assertEqual(p.returncode, 2)
         self.assertIn("other settings", p.stderr)
+        # --dry-run says so too, instead of listing those runs as done or runnable.
+        p = self.sweep("--set", "landing.speed=0.1", "--dry-run")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("moderate_d30_BCF_a0_r0: done, with other settings: the sweep refuses it", p.stdout)
+        # A record folder that cannot be written is refused before any run (not a traceback after the first).
+        # (Below a regular file: no folder can be made there, even by root.)
+        blocker = os.path.join(self.dir, "a_file")
+        open(blocker, "w").close()
+        p = self.sweep("--record", os.path.join(blocker, "rec"))
+        self.assertEqual(p.returncode, 2, p.stdout + p.stderr)
+        self.assertIn("the record folder (--record) cannot be written", p.stderr)
+        self.assertNotIn("Traceback", p.stderr)
         # Report only.
         os.remove(os.path.join(self.out, "report.md"))
         p = subprocess.run([sys.executable, SWEEP, "--out", self.out, "--report-only", "--spread", "sd"],

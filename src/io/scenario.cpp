@@ -163,19 +163,13 @@ RadiusDist parse_radius(const Reader& rd, const YAML::Node& g, const std::string
   return d;
 }
 
-std::string num_text(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
-
 // The keys that give a fill's region, with their values, for messages.
 std::string region_keys(const std::string& fp, const Region& r) {
   if (r.shape == RegionShape::Box)
-    return Reader::join(fp, "lo") + " to " + Reader::join(fp, "hi") + ", " + num_text((r.hi - r.lo).x()) + " x " +
-           num_text((r.hi - r.lo).y()) + " x " + num_text((r.hi - r.lo).z()) + " m";
-  return Reader::join(fp, "radius") + " = " + num_text(r.radius) + " m, " + Reader::join(fp, "z") + " = [" +
-         num_text(r.lo.z()) + ", " + num_text(r.hi.z()) + "] m";
+    return Reader::join(fp, "lo") + " to " + Reader::join(fp, "hi") + ", " + Reader::num_text((r.hi - r.lo).x()) + " x " +
+           Reader::num_text((r.hi - r.lo).y()) + " x " + Reader::num_text((r.hi - r.lo).z()) + " m";
+  return Reader::join(fp, "radius") + " = " + Reader::num_text(r.radius) + " m, " + Reader::join(fp, "z") + " = [" +
+         Reader::num_text(r.lo.z()) + ", " + Reader::num_text(r.hi.z()) + "] m";
 }
 
 Region parse_region(const Reader& rd, const YAML::Node& f, const std::string& path) {
@@ -236,8 +230,8 @@ void parse_grains(const Reader& rd, Scenario& sc, const YAML::Node& g, const std
       if (long(pos.size()) < count)
         rd.fail(Reader::join(fp, "count"), std::to_string(count) + " grains do not fit in the region (room for " +
                                                 std::to_string(pos.size()) + ") at " + Reader::join(fp, "spacing") +
-                                                " = " + num_text(spacing) + " m (from " + Reader::join(path, "radius") +
-                                                " " + num_text(dist.mean) + " m): make the region (" +
+                                                " = " + Reader::num_text(spacing) + " m (from " + Reader::join(path, "radius") +
+                                                " " + Reader::num_text(dist.mean) + " m): make the region (" +
                                                 region_keys(fp, region) + ") larger or the grains fewer");
       radii = draw_radii(dist, int(pos.size()), rng);
     } else {
@@ -461,10 +455,9 @@ void apply_override(YAML::Node root, const std::string& assignment) {
 }  // namespace
 
 std::string body_names_text(const Model& m) {
-  std::string t;
-  for (size_t k = 0; k < m.bodies.size(); ++k)
-    t += (k ? ", " : "") + std::string("bodies[") + std::to_string(k) + "].name = '" + m.bodies[k].name + "'";
-  return t.empty() ? "no bodies" : t;
+  std::vector<std::string> names;
+  for (const BodyModel& b : m.bodies) names.push_back(b.name);
+  return Reader::entry_names("bodies", names);
 }
 
 bool material_preset(const std::string& name, Material& out) {
@@ -845,10 +838,10 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
         for (const auto& x : h) {
           const std::string gname = x.as<std::string>();
           if (!sc.group(gname)) {
-            std::string names;
-            for (size_t k = 0; k < sc.groups.size(); ++k)
-              names += (k ? ", " : "") + std::string("grains[") + std::to_string(k) + "].name = '" + sc.groups[k].name + "'";
-            rd.fail(p + ".hold", "unknown grain group '" + gname + "' (the groups: " + names + ")");
+            std::vector<std::string> names;
+            for (const GrainGroup& g : sc.groups) names.push_back(g.name);
+            rd.fail(p + ".hold",
+                    "unknown grain group '" + gname + "' (the groups: " + Reader::entry_names("grains", names) + ")");
           }
           s.hold.push_back(gname);
         }
@@ -860,10 +853,10 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
           bool found = false;
           for (const auto& w : m.walls) found = found || w.name == wname;
           if (!found) {
-            std::string names;
-            for (size_t k = 0; k < m.walls.size(); ++k)
-              names += (k ? ", " : "") + std::string("walls[") + std::to_string(k) + "].name = '" + m.walls[k].name + "'";
-            rd.fail(p + ".remove_walls", "unknown wall '" + wname + "' (the walls: " + (names.empty() ? "none" : names) + ")");
+            std::vector<std::string> names;
+            for (const Wall& w : m.walls) names.push_back(w.name);
+            rd.fail(p + ".remove_walls",
+                    "unknown wall '" + wname + "' (the walls: " + Reader::entry_names("walls", names) + ")");
           }
           s.remove_walls.push_back(wname);
         }

@@ -17,6 +17,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -370,39 +371,46 @@ TEST(TwinNodeServices, ABlockingCheckpointPathDoesNotStopTheNode) {
   EXPECT_TRUE(step(2).success);
 }
 
-TEST(TwinNodeServices, TwoPipeLoadsLeavePauseAnswered) {
-  // Two loads from pipes nobody writes: they wait on the node's I/O thread
-  // (until ~io_timeout), while pause, unpause and step answer at once.
+TEST(TwinNodeServices, PipeLoadsLeavePauseAnswered) {
+  // Loads from pipes nobody writes, one for each thread of this process's
+  // spinner (3, main below): on the shared queue they would hold every thread
+  // that serves pause. They wait on the node's own I/O thread instead (until
+  // ~io_timeout, one after the other), while pause, unpause and step answer at once.
+  constexpr int kLoads = 3;
   char dir[] = "/tmp/regolith_fifo2_XXXXXX";
   ASSERT_NE(mkdtemp(dir), nullptr);
-  const std::string a = std::string(dir) + "/a.ckpt", b = std::string(dir) + "/b.ckpt";
-  ASSERT_EQ(mkfifo(a.c_str(), 0600), 0);
-  ASSERT_EQ(mkfifo(b.c_str(), 0600), 0);
-  auto l1 = persistent_client<regolith_twin::Checkpoint>("load_checkpoint");
-  auto l2 = persistent_client<regolith_twin::Checkpoint>("load_checkpoint");
-  regolith_twin::Checkpoint c1, c2;
-  c1.request.path = a;
-  c2.request.path = b;
+  std::vector<std::string> pipes;
+  std::vector<ros::ServiceClient> clients;
+  std::vector<regolith_twin::Checkpoint> calls(kLoads);
+  for (int k = 0; k < kLoads; ++k) {
+    pipes.push_back(std::string(dir) + "/p" + std::to_string(k) + ".ckpt");
+    ASSERT_EQ(mkfifo(pipes.back().c_str(), 0600), 0);
+    clients.push_back(persistent_client<regolith_twin::Checkpoint>("load_checkpoint"));
+    calls[k].request.path = pipes.back();
+  }
   std::atomic<int> answered{0};
-  std::thread t1([&] { EXPECT_TRUE(l1.call(c1)); ++answered; });
-  std::thread t2([&] { EXPECT_TRUE(l2.call(c2)); ++answered; });
+  std::vector<std::thread> loads;
+  for (int k = 0; k < kLoads; ++k)
+    loads.emplace_back([&, k] {
+      EXPECT_TRUE(clients[k].call(calls[k]));
+      ++answered;
+    });
   ros::WallDuration(0.3).sleep();
   EXPECT_EQ(answered, 0) << "the loads wait for their pipes";
   for (const char* name : {"unpause", "pause"}) {
     const ros::WallTime t0 = ros::WallTime::now();
     EXPECT_TRUE(trigger(name));
-    EXPECT_LT((ros::WallTime::now() - t0).toSec(), 1.0) << name << " answered while two loads wait";
+    EXPECT_LT((ros::WallTime::now() - t0).toSec(), 1.0) << name << " answered while the loads wait";
   }
   const ros::WallTime t0 = ros::WallTime::now();
   EXPECT_TRUE(step(3).success);
   EXPECT_LT((ros::WallTime::now() - t0).toSec(), 1.0);
-  t1.join();
-  t2.join();
-  EXPECT_FALSE(c1.response.success);
-  EXPECT_FALSE(c2.response.success);
-  EXPECT_NE(c1.response.message.find("within"), std::string::npos) << c1.response.message;
-  std::remove(a.c_str());
-  std::remove(b.c_str());
+  for (std::thread& t : loads) t.join();
+  for (const auto& c : calls) {
+    EXPECT_FALSE(c.response.success);
+    EXPECT_NE(c.response.message.find("within"), std::string::npos) << c.response.message;
+  }
+  for (const std::string& p : pipes) std::remove(p.c_str());
   rmdir(dir);
 }
 

@@ -197,16 +197,27 @@ class YamlReader {
 
   const std::string& source() const { return source_; }
 
+  // A number as messages print it (6 significant digits).
+  static std::string num_text(double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  }
+
+  // "list[0].name = 'a', list[1].name = 'b'" ("none" when empty): the entries
+  // a reference may name, for the message of one that names none of them.
+  static std::string entry_names(const std::string& list, const std::vector<std::string>& names) {
+    std::string t;
+    for (size_t k = 0; k < names.size(); ++k)
+      t += (k ? ", " : "") + list + "[" + std::to_string(k) + "].name = '" + names[k] + "'";
+    return t.empty() ? "none" : t;
+  }
+
  private:
   static std::string scalar_text(const YAML::Node& n) {
     if (n.IsScalar()) return n.Scalar();
     std::ostringstream os;
     os << n;
-    return os.str();
-  }
-  static std::string num_text(double v) {
-    std::ostringstream os;
-    os << v;
     return os.str();
   }
   static std::string range_text(double lo, double hi, bool lo_open) {

@@ -140,12 +140,18 @@ def hold_folder(out):
     return f
 
 
+MAX_JSON_BYTES = 16 << 20  # a run's records are a few kB
+
+
 def read_json(path):
     """The JSON object in PATH; None when it is missing, unreadable, or not an
     object (a file of the right name and the wrong shape is not a run's)."""
     try:
+        # a regular file of a record's size: a device or a pipe is not read
+        if not os.path.isfile(path) or os.path.getsize(path) > MAX_JSON_BYTES:
+            return None
         with open(path) as f:
-            v = json.load(f)
+            v = json.loads(f.read(MAX_JSON_BYTES + 1))
     except (OSError, ValueError, RecursionError):
         return None
     return v if isinstance(v, dict) else None
@@ -800,7 +806,12 @@ def report(a):
 
 # ---------------------------------------------------------------- main
 
-def main(argv=None):
+MAX_REPEATS = 1000   # beds per grid point
+MAX_RUNS = 100000    # runs in one sweep
+
+
+def make_parser():
+    """The sweep's flags (test/sweep/test_sweep_flags.py fuzzes every one of them)."""
     ap = argparse.ArgumentParser(
         prog="scripts/sweep",
         description="MASCOT landing sweep: materials x depths x attitudes x angles x repeats of regolith_land.",
@@ -844,6 +855,11 @@ def main(argv=None):
                     help="folder of one small JSON per finished run (to commit); runs recorded there count as done")
     ap.add_argument("--report-only", action="store_true", help="only write aggregate.csv, plots, report.md")
     ap.add_argument("--dry-run", action="store_true", help="list the runs and their state, run nothing")
+    return ap
+
+
+def main(argv=None):
+    ap = make_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
     if len(argv) == 3 and argv[0] == "--slurm-task":
         # A Slurm array task: the driver's own arguments, from its batch file.
@@ -865,25 +881,39 @@ def main(argv=None):
     depths = split_list(a.depths, float, "depths")
     atts = split_list(a.attitudes, str, "attitudes")
     angles = split_list(a.angles, float, "angles")
+    for m in mats:
+        # a preset's name, also part of file names: no path, no spaces
+        if not (m.replace("_", "").isalnum() and m.isascii() and len(m) <= 40):
+            fail(f"--materials: '{m[:60]}' is not a material preset's name (letters, digits, _; e.g. moderate)")
     for t in atts:
         if t not in ("Flat", "BCF", "FCF"):
-            fail(f"--attitudes: '{t}' is not one of Flat, BCF, FCF")
+            fail(f"--attitudes: '{t[:60]}' is not one of Flat, BCF, FCF")
     for d in depths:
         if not 0 < d < 2:
-            fail(f"--depths: {d} m is out of range")
-    if a.repeats < 1:
-        fail("--repeats: at least 1")
-    if a.threads < 0:
-        fail("--threads: at least 1")
+            fail(f"--depths: {d} m is out of range (0, 2) m")
+    for ang in angles:
+        if not 0 <= ang < 90:
+            fail(f"--angles: {ang} deg is out of range [0, 90) deg from the vertical")
+    if not 1 <= a.repeats <= MAX_REPEATS:
+        fail(f"--repeats {a.repeats}: expected 1 to {MAX_REPEATS}")
+    if not 0 <= a.threads <= 256:
+        fail(f"--threads {a.threads}: expected 1 to 256 (0: regolith_land's default)")
     if not 1 <= a.jobs <= 256:
         fail(f"--jobs {a.jobs}: expected 1 to 256")
+    if not 0 <= a.slurm_retries <= 100:
+        fail(f"--slurm-retries {a.slurm_retries}: expected 0 to 100")
+    if not 0.1 <= a.slurm_poll <= 3600:
+        fail(f"--slurm-poll {a.slurm_poll}: expected 0.1 to 3600 s")
     for s in a.set:
-        if "=" not in s:
-            fail(f"--set '{s}': expected key=value")
+        if "=" not in s or not s.split("=", 1)[0].strip():
+            fail(f"--set '{s[:60]}': expected key=value")
+    n_runs = len(mats) * len(depths) * len(atts) * len(angles) * a.repeats
+    if n_runs > MAX_RUNS:
+        fail(f"the grid has {n_runs} runs, more than {MAX_RUNS}: split it into several sweeps")
     if not os.path.isfile(a.config):
         fail(f"landing file {a.config} not found")
     land = os.path.abspath(a.land)
-    if not a.dry_run and not os.access(land, os.X_OK):
+    if not a.dry_run and not (os.path.isfile(land) and os.access(land, os.X_OK)):
         fail(f"regolith_land not found at {land} (build first: scripts/sweep builds it)")
     sim = a.sim or os.path.join(os.path.dirname(land), "regolith_sim")
 

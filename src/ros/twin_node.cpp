@@ -282,7 +282,10 @@ void TwinNode::loop() {
       step_cv_.notify_all();
       ROS_ERROR("twin_node: %s (the run is stopped; reset or load a checkpoint to go on)", e.what());
       publish_diagnostics(diagnostic_msgs::DiagnosticStatus::ERROR, failure_);
-      after_step(true);
+      // The failed step's state is not published: the topics keep the last
+      // sound values (docs/ros.md); /clock and ~status say where it stopped.
+      publish_clock();
+      publish_status();
       on_end();
       continue;
     }
@@ -324,9 +327,11 @@ void TwinNode::on_end() {
       ROS_ERROR("twin_node: cannot write the run's files to %s: %s", p_.out_dir.c_str(), e.what());
     }
   }
-  topics_->on_end(*twin_);
-  // The final grains, whatever the particle rate (a recording ends with the run's last state).
-  if (particles_pub_.getNumSubscribers() > 0) publish_particles();
+  if (!failed_) {
+    topics_->on_end(*twin_);
+    // The final grains, whatever the particle rate (a recording ends with the run's last state).
+    if (particles_pub_.getNumSubscribers() > 0) publish_particles();
+  }
   paused_ = true;  // stays up for inspection; unpause steps on past the run end
   if (p_.shutdown_at_end) ros::requestShutdown();
 }
@@ -582,8 +587,12 @@ void TwinNode::publish_status() {
   for (int i = 0; i < m.n_grains; ++i) frozen += held(m, i);
   msg.frozen_grains = frozen;
   msg.active_grains = uint32_t(m.n_grains) - frozen;
-  msg.max_overlap_ratio = s.stats.max_overlap_ratio;
-  msg.kinetic_energy = rt::kinetic_energy(m, s);
+  if (!failed_) {
+    status_overlap_ = s.stats.max_overlap_ratio;
+    status_ke_ = rt::kinetic_energy(m, s);
+  }
+  msg.max_overlap_ratio = status_overlap_;
+  msg.kinetic_energy = status_ke_;
   status_pub_.publish(msg);
   last_status_wall_ = now;
   status_sim0_ = s.time;
@@ -833,6 +842,9 @@ bool TwinNode::on_save(regolith_twin::Checkpoint::Request& req, regolith_twin::C
     double t = 0;
     {
       std::lock_guard<std::mutex> lk(mu_);
+      if (failed_)
+        throw std::runtime_error("the run stopped on a blow-up (" + failure_ +
+                                 "): its state is not saved; reset or load a checkpoint first");
       image = twin_->checkpoint_image();
       t = twin_->state().time;
     }
@@ -877,6 +889,9 @@ bool TwinNode::on_set_body_state(regolith_twin::SetBodyState::Request& req, rego
   } else if (twin_->model().bodies[b].fixed) {
     res.success = false;
     res.message = "body '" + req.body + "' is fixed";
+  } else if (failed_) {
+    res.success = false;
+    res.message = "the run stopped on a blow-up (" + failure_ + "); reset or load a checkpoint first";
   } else {
     const auto& p = req.pose.position;
     try {
@@ -907,14 +922,14 @@ bool TwinNode::on_apply_wrench(regolith_twin::ApplyBodyWrench::Request& req,
     res.success = false;
     res.message = "body '" + req.body + "' is fixed";
   } else {
-    const Vec3 f = from_vector(req.wrench.force), t = from_vector(req.wrench.torque);
-    if (!f.allFinite() || !t.allFinite()) {
-      res.success = false;
-      res.message = "wrench has non-finite components";
-    } else {
-      twin_->apply_wrench(b, f, t, twin_->state().time + req.duration);
+    try {  // a non-finite wrench or one beyond the acceleration bounds is refused with its numbers
+      twin_->apply_wrench(b, from_vector(req.wrench.force), from_vector(req.wrench.torque),
+                          twin_->state().time + req.duration);
       res.success = true;
       res.message = "ok";
+    } catch (const rt::InputError& e) {
+      res.success = false;
+      res.message = e.what();
     }
   }
   return true;

@@ -14,6 +14,11 @@ std::string vec_text(const Vec3& v) {
   os << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
   return os.str();
 }
+std::string number_text(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
 }  // namespace
 
 Twin::Twin(const TwinOptions& opt) : file_(opt.file), max_steps_(opt.scene.max_steps) {
@@ -109,6 +114,14 @@ void Twin::set_body_state(int b, const Vec3& ref_pos, const Quat& ref_q, const V
   if (!ref_pos.allFinite() || !vel.allFinite() || !omega.allFinite() || !(qn > 1e-9) || !std::isfinite(qn))
     throw InputError("body '" + bm.name + "': the new state must be finite with a non-zero orientation (position " +
                      vec_text(ref_pos) + ", velocity " + vec_text(vel) + ", angular velocity " + vec_text(omega) + ")");
+  // The bounds of a loaded state (docs/scenes.md, "Input ranges"): a step,
+  // the neighbour grid and the published messages need values of a physical size.
+  static_assert(kMaxCoordinate == 1e6 && kMaxStateSpeed == 1e6, "the message names these bounds");
+  if (!(ref_pos.cwiseAbs().maxCoeff() <= kMaxCoordinate) || !(vel.cwiseAbs().maxCoeff() <= kMaxStateSpeed) ||
+      !(omega.cwiseAbs().maxCoeff() <= kMaxStateSpeed))
+    throw InputError("body '" + bm.name + "': position " + vec_text(ref_pos) + ", velocity " + vec_text(vel) +
+                     ", angular velocity " + vec_text(omega) +
+                     ": allowed components within 1e6 m, 1e6 m/s and 1e6 rad/s");
   const Quat q_ref = ref_q.normalized();
   bs.q = (q_ref * bm.ref_rot).normalized();
   bs.pos = ref_pos + q_ref * bm.ref_pos;
@@ -121,6 +134,18 @@ void Twin::set_body_state(int b, const Vec3& ref_pos, const Quat& ref_q, const V
 }
 
 void Twin::apply_wrench(int b, const Vec3& force, const Vec3& torque, double until) {
+  const BodyModel& bm = model_.bodies.at(b);
+  // A push must keep the body's accelerations physical: at most 1e6 m/s^2
+  // and 1e6 rad/s^2 (the state bounds reached in one second).
+  const double a = force.norm() / bm.mass, alpha = torque.norm() / bm.inertia.minCoeff();
+  if (!force.allFinite() || !torque.allFinite() || !(a <= kMaxStateSpeed) || !(alpha <= kMaxStateSpeed))
+    throw InputError("body '" + bm.name + "': force " + vec_text(force) + " N and torque " + vec_text(torque) +
+                     " N m give accelerations of " + number_text(a) + " m/s^2 and " + number_text(alpha) +
+                     " rad/s^2: allowed up to 1e6 each (|F| <= " + number_text(kMaxStateSpeed * bm.mass) +
+                     " N, |torque| <= " + number_text(kMaxStateSpeed * bm.inertia.minCoeff()) + " N m)");
+  if (!(until >= state_.time) || !(until <= kMaxStateTime))
+    throw InputError("body '" + bm.name + "': the push would end at t = " + number_text(until) +
+                     " s: allowed up to 1e9 s");
   const size_t n = model_.bodies.size();
   if (state_.body_applied_force.size() != n) {
     state_.body_applied_force.assign(n, Vec3::Zero());

@@ -100,6 +100,30 @@ TEST(Twin, ANonFiniteBodyStateIsRefusedAndChangesNothing) {
     EXPECT_EQ(twin.state().bodies[b].pos, before.pos);
     EXPECT_EQ(twin.state().bodies[b].vel, before.vel);
   }
+  // Finite but beyond the state bounds (1e6 m, m/s, rad/s), and a push
+  // beyond 1e6 m/s^2 or rad/s^2: refused with the bounds, nothing changed.
+  for (const Case& c : {Case{rt::Vec3(0, 0, 1e300), z, z, q}, Case{p, rt::Vec3(2e6, 0, 0), z, q},
+                        Case{p, z, rt::Vec3(0, -2e6, 0), q}}) {
+    try {
+      twin.set_body_state(b, c.pos, c.q, c.vel, c.omega);
+      ADD_FAILURE() << "a body state beyond the bounds was accepted";
+    } catch (const rt::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("within 1e6 m"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(twin.state().bodies[b].pos, before.pos);
+  }
+  const double m = twin.model().bodies[b].mass, i_min = twin.model().bodies[b].inertia.minCoeff();
+  for (const auto& [f, t] : {std::pair(rt::Vec3(0, 0, 1e300), z), std::pair(rt::Vec3(0, 0, 1.01e6 * m), z),
+                             std::pair(z, rt::Vec3(1.01e6 * i_min, 0, 0)), std::pair(rt::Vec3(nan, 0, 0), z)}) {
+    try {
+      twin.apply_wrench(b, f, t, twin.state().time + 1);
+      ADD_FAILURE() << "a push beyond the bounds was accepted: " << f.transpose() << ", " << t.transpose();
+    } catch (const rt::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("allowed up to 1e6"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NO_THROW(twin.apply_wrench(b, rt::Vec3(0, 0, 0.99e6 * m), z, twin.state().time + 1e-9));
+  EXPECT_NO_THROW(twin.apply_wrench(b, z, z, twin.state().time));
   twin.step();  // and the twin steps on
   EXPECT_TRUE(twin.state().bodies[b].pos.allFinite());
 }

@@ -123,7 +123,8 @@ class TwinNode {
   long pending_steps_ = 0;
   double pending_until_ = -1;  // a ~step by duration: simulated time it ends at (-1: by count)
   bool step_cancelled_ = false;  // the ~step in progress was cancelled by ~pause
-  bool failed_ = false;              // a blow-up stopped the run
+  bool failed_ = false;              // a blow-up stopped the run: its state is not published, saved or edited
+  double status_ke_ = 0, status_overlap_ = 0;  // the last values ~status published from a sound state
   std::string failure_;
   std::atomic<bool> running_{false};
   std::thread thread_;

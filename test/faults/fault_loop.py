@@ -16,8 +16,12 @@ must hold afterwards (docs/files.md, outputs; docs/validation/reliability.md):
 Kinds: sim (regolith_sim, a small box, with --checkpoint and --snapshot),
 land (regolith_land, a short landing whose bed is relaxed and cached first,
 half of the time with the cache emptied before), save (either, killed while
-one of its files is under its temporary name) and sweep (scripts/lib/sweep.py
-with the stand-in regolith_land of test/sweep). The first uninterrupted run of
+one of its files is under its temporary name), sweep (scripts/lib/sweep.py
+with the stand-in regolith_land of test/sweep) and stale (the landing killed
+in a folder that holds a finished landing of another speed: none of that
+run's files may stay beside a file of the new run's, but for the
+checkpoint the user named, which keeps its previous version until
+replaced). The first uninterrupted run of
 each kind is the reference; the landing's is also re-run from its cached bed
 with --relaxed-bed (the checkpoint loads, and the run is bit-identical).
 
@@ -44,7 +48,11 @@ SWEEP = os.path.join(ROOT, "scripts", "lib", "sweep.py")
 FAKE = os.path.join(ROOT, "test", "sweep", "fake_land.py")
 TINY = os.path.join(ROOT, "test", "ros", "tiny_box.yaml")
 PLATE = os.path.join(ROOT, "test", "ros", "plate_landing.yaml")
-KINDS = ("sim", "land", "save", "sweep")
+KINDS = ("sim", "land", "save", "sweep", "stale")
+# Files at paths the user names (--checkpoint, --snapshot): the previous
+# complete version stays until the new one replaces it (docs/files.md), so a
+# failed or killed run never costs the user the state it would resume from.
+KEPT_UNTIL_REPLACED = ("final.ckpt", "final.bed")
 TEMP = re.compile(r"\.tmp\.(\d+)$")
 # Fields that differ between two uninterrupted runs: wall-clock time and rates.
 VOLATILE_KEYS = re.compile(r"wall|per_second|steps_per_s|^started$|^start$|^end$|^restored_from$")
@@ -130,6 +138,35 @@ class Checker:
         elif data != ref:
             raise Failure(f"{path}: {len(data)} bytes, not the uninterrupted run's {len(ref)}")
 
+    def stale(self, d, ref_dir, other_dir, killed):
+        """After a kill in a folder that held another run's outputs: every file
+        is the new run's (as in folder) or the other run's, and the other
+        run's files are left only while the new run has written nothing
+        (a run removes every output it will write before its first step)."""
+        got, ref, other = files_under(d), files_under(ref_dir), files_under(other_dir)
+        new, old = [], []
+        for rel, path in sorted(got.items()):
+            if os.path.basename(rel) in (".regolith_twin.lock", *KEPT_UNTIL_REPLACED) or TEMP.search(rel):
+                continue
+            data = read(path)
+            try:
+                if rel not in ref:
+                    raise Failure(f"{path}: not written by the uninterrupted run")
+                self.same(rel, path, data, read(ref[rel]), False)
+                is_new = True
+            except Failure:
+                is_new = False
+            is_old = rel in other and data == read(other[rel])
+            if not is_new and not is_old:
+                raise Failure(f"{path}: neither this run's nor the earlier run's")
+            if is_old and not is_new:
+                old.append(rel)
+            elif is_new and not is_old:
+                new.append(rel)
+        if old and new:
+            raise Failure(f"{d}: the earlier run's {', '.join(old)} beside this run's {', '.join(new)}")
+        self.stats["stale_kills_with_new_files" if new else "stale_kills_before_writing"] += 1
+
     @staticmethod
     def restored(d, rel):
         """A sweep's run taken from its record: summary.json and sweep_run.json only."""
@@ -190,7 +227,7 @@ class Loop:
         self.stats = {"kills": 0, "kills_by_kind": {k: 0 for k in KINDS}, "land_killed_relaxing": 0,
                       "land_killed_landing": 0, "save_targets": {}, "second_run_refused": 0,
                       "temp_files_left": 0, "files_checked": 0, "resumed_identical": 0, "finished_before_kill": 0,
-                      "save_missed": 0}
+                      "save_missed": 0, "stale_kills_with_new_files": 0, "stale_kills_before_writing": 0}
         self.check = Checker(self.stats)
         self.killed = set()
         self.beds = os.path.join(self.work, "beds")
@@ -258,6 +295,14 @@ class Loop:
             self.check.same(f, f"{other}/{f}", read(f"{other}/{f}"), read(f"{w}/ref_land/{f}"), True)
         self.finish(self.land_cmd(other, f"{w}/unused_cache") + ["--relaxed-bed", f"{w}/ref_land/final.ckpt"],
                     "landing from the final checkpoint")
+        # A finished landing of another speed, made in the landing's folder
+        # (its outputs name their paths), kept for the stale kind; then the
+        # reference landing over it, whole and identical.
+        self.finish(self.land_cmd(f"{w}/land", f"{w}/cache_other") + ["--set", "landing.speed=0.4"],
+                    "a landing of another speed")
+        shutil.copytree(f"{w}/land", f"{w}/other_land")
+        self.finish(self.land_cmd(f"{w}/land", f"{w}/cache"), "the landing over another one")
+        self.check.folder(f"{w}/land", f"{w}/ref_land", whole=True)
         print(f"references: sim {self.t_sim:.2f} s, landing {self.t_land:.2f} s (bed relaxed and cached; "
               f"{self.t_land_cached:.2f} s from the cache), sweep {self.t_sweep:.2f} s", flush=True)
 
@@ -338,6 +383,17 @@ class Loop:
             self.check.folder(f"{w}/cache", self.ref_cache, whole=True)
         elif kind == "save":
             ok = self.save_kill()
+        elif kind == "stale":
+            shutil.rmtree(f"{w}/land")
+            shutil.copytree(f"{w}/other_land", f"{w}/land")
+            ok = self.timed_kill(self.land_cmd(f"{w}/land", f"{w}/cache"), self.t_land_cached, f"{w}/land", "run")
+            for rel, path in files_under(f"{w}/land").items():  # the killed process's temporary files
+                m = TEMP.search(rel)
+                if m and int(m.group(1)) in self.killed:
+                    os.remove(path)
+            self.check.stale(f"{w}/land", f"{w}/ref_land", f"{w}/other_land", self.killed)
+            self.finish(self.land_cmd(f"{w}/land", f"{w}/cache"), "landing after a kill over another landing")
+            self.check.folder(f"{w}/land", f"{w}/ref_land", whole=True)
         else:
             # Some runs to redo: their folders removed, and half of their records
             # (a recorded run is restored from its record, not run again).

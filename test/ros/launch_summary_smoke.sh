@@ -9,6 +9,15 @@ set -uo pipefail
 [ $# -ge 4 ] || { echo "usage: $0 BASE_PORT LAUNCH TOPIC PATTERN [ARG:=VALUE ...]" >&2; exit 2; }
 base=$1 launch_file=$2 topic=$3 pattern=$4
 shift 4
+# Under ThreadSanitizer the node runs OpenMP on one thread, as every node test
+# does there (docs/validation/reliability.md, "Sanitizers"): libgomp is not
+# instrumented, so the end of a parallel region is invisible to it and a
+# later write by the main thread is reported as a race.
+if [ "${REGOLITH_SANITIZER:-}" = thread ]; then
+  args=()
+  for a in "$@"; do case $a in threads:=*) ;; *) args+=("$a") ;; esac; done
+  set -- "${args[@]}" threads:=1
+fi
 source "$(dirname "${BASH_SOURCE[0]}")/ros_env.sh" "$base"
 log=$(mktemp)
 out=$(mktemp -d)

@@ -6,17 +6,13 @@
 
 #include "regolith_twin/core/step.hpp"
 #include "regolith_twin/io/checkpoint.hpp"
+#include "regolith_twin/io/yaml_reader.hpp"
 
 namespace rt {
 namespace {
 std::string vec_text(const Vec3& v) {
   std::ostringstream os;
   os << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
-  return os.str();
-}
-std::string number_text(double v) {
-  std::ostringstream os;
-  os << v;
   return os.str();
 }
 }  // namespace
@@ -140,11 +136,11 @@ void Twin::apply_wrench(int b, const Vec3& force, const Vec3& torque, double unt
   const double a = force.norm() / bm.mass, alpha = torque.norm() / bm.inertia.minCoeff();
   if (!force.allFinite() || !torque.allFinite() || !(a <= kMaxStateSpeed) || !(alpha <= kMaxStateSpeed))
     throw InputError("body '" + bm.name + "': force " + vec_text(force) + " N and torque " + vec_text(torque) +
-                     " N m give accelerations of " + number_text(a) + " m/s^2 and " + number_text(alpha) +
-                     " rad/s^2: allowed up to 1e6 each (|F| <= " + number_text(kMaxStateSpeed * bm.mass) +
-                     " N, |torque| <= " + number_text(kMaxStateSpeed * bm.inertia.minCoeff()) + " N m)");
+                     " N m give accelerations of " + YamlReader::num_text(a) + " m/s^2 and " + YamlReader::num_text(alpha) +
+                     " rad/s^2: allowed up to 1e6 each (|F| <= " + YamlReader::num_text(kMaxStateSpeed * bm.mass) +
+                     " N, |torque| <= " + YamlReader::num_text(kMaxStateSpeed * bm.inertia.minCoeff()) + " N m)");
   if (!(until >= state_.time) || !(until <= kMaxStateTime))
-    throw InputError("body '" + bm.name + "': the push would end at t = " + number_text(until) +
+    throw InputError("body '" + bm.name + "': the push would end at t = " + YamlReader::num_text(until) +
                      " s: allowed up to 1e9 s");
   const size_t n = model_.bodies.size();
   if (state_.body_applied_force.size() != n) {

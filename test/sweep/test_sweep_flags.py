@@ -117,7 +117,7 @@ class SweepFlags(unittest.TestCase):
         out = os.path.join(cwd, values[0]) if flag == "--out" else args["--out"]
         agg = os.path.join(out, "aggregate.csv")
         ran = p.returncode == 0 and flag not in ("--dry-run", "--report-only", "--slurm-task", "--no-wait")
-        if ran and values != ["--help"]:
+        if ran:
             if not os.path.isfile(agg):
                 problems.append("exit 0 without aggregate.csv")
             else:

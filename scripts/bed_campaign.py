@@ -93,6 +93,17 @@ def beds():
                       "grains.0.fill.z=[0.0,%.4f]" % top, "stages.1.trim_above=%.2f" % (cm / 100)]
                 out[name] = ("mascot_bed.yaml", ov, "32", PUBLISHED["mascot_%s_d%d" % (mat, cm)], MASCOT_R,
                              cm / 100)
+    # Graded 30 cm beds (config/beds/mascot_bed_graded.yaml; docs/scenes.md E.1): the same region,
+    # fraction and seeds as the shipped 30 cm beds, the grading's heights mapped by the pile's
+    # compaction (its height over the region's).
+    for mat in MATERIALS:
+        for seed in (1, 2, 3):
+            name = "mascot_%s_d30_ga%s" % (mat, "" if seed == 1 else "_s%d" % seed)
+            _, top = fill(MASCOT_R, 0.30, MARGIN["mascot"], mean_volume())
+            ov = ["materials.regolith.preset=%s" % mat, "materials.container.preset=%s" % mat,
+                  "seed=%d" % (2018 + seed - 1), "grains.0.fill.z=[0.0,%.4f]" % top,
+                  "grains.0.fill.grading.compaction=%.4f" % ((0.30 + MARGIN["mascot"]) / top)]
+            out[name] = ("mascot_bed_graded.yaml", ov, "32", None, MASCOT_R, 0.30)
     for seed in (1, 2, 3):
         name = "sampler_gravel%s" % ("" if seed == 1 else "_s%d" % seed)
         count, top = fill(SAMPLER_R, 0.20, MARGIN["sampler"], grain_volume(0.0025, 0.30))

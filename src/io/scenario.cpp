@@ -194,6 +194,38 @@ Region parse_region(const Reader& rd, const YAML::Node& f, const std::string& pa
   return r;
 }
 
+// A random fill's `grading` (docs/scenes.md E.1, "Graded fills").
+Grading parse_grading(const Reader& rd, const YAML::Node& f, const std::string& fp, const Region& region,
+                      const RadiusDist& dist) {
+  const std::string gp = Reader::join(fp, "grading");
+  const YAML::Node g = rd.map(f, fp, "grading", true);
+  rd.only(g, gp, {"surface", "base", "compaction", "center", "fine_depth", "fine_radius", "depth_rate", "radial_rate",
+                  "max_scale"});
+  Grading gr;
+  if (!Reader::get(g, "surface")) rd.fail(Reader::join(gp, "surface"), "missing (z of the settled bed's surface, m)");
+  gr.surface = rd.number(g, gp, "surface", 0, -kMaxSceneLength, kMaxSceneLength);
+  gr.base = rd.number(g, gp, "base", region.lo.z(), -kMaxSceneLength, kMaxSceneLength);
+  gr.compaction = rd.number(g, gp, "compaction", 1.0, 1e-3, 1.0);
+  const YAML::Node c = g["center"];
+  const Vec3 mid = region.shape == RegionShape::Cylinder ? region.center : Vec3(0.5 * (region.lo + region.hi));
+  gr.center_x = mid.x();
+  gr.center_y = mid.y();
+  if (c) {
+    if (!c.IsSequence() || c.size() != 2) rd.fail(Reader::join(gp, "center"), "expected [x, y] (m)");
+    gr.center_x = rd.number(c[0], Reader::join(gp, "center[0]"), -kMaxSceneLength, kMaxSceneLength);
+    gr.center_y = rd.number(c[1], Reader::join(gp, "center[1]"), -kMaxSceneLength, kMaxSceneLength);
+  }
+  gr.fine_depth = rd.number(g, gp, "fine_depth", 0, 0, kMaxSceneLength);
+  gr.fine_radius = rd.number(g, gp, "fine_radius", 0, 0, kMaxSceneLength);
+  gr.depth_rate = rd.number(g, gp, "depth_rate", 0, 0, 10);
+  gr.radial_rate = rd.number(g, gp, "radial_rate", 0, 0, 10);
+  gr.max_scale = rd.number(g, gp, "max_scale", 4, 1, 10);
+  gr.mean_diameter = 2 * dist.mean;
+  if (g["radial_rate"] && !g["fine_radius"])
+    rd.fail(Reader::join(gp, "fine_radius"), "missing (the fine zone's radius around center, m; radial_rate needs it)");
+  return gr;
+}
+
 // One `grains` entry: explicit grain, lattice fill or data file.
 void parse_grains(const Reader& rd, Scenario& sc, const YAML::Node& g, const std::string& path,
                   std::mt19937_64& rng) {
@@ -216,13 +248,17 @@ void parse_grains(const Reader& rd, Scenario& sc, const YAML::Node& g, const std
   } else if (g["fill"]) {
     const std::string fp = Reader::join(path, "fill");
     const YAML::Node f = rd.map(g, path, "fill", true);
-    rd.only(f, fp, {"shape", "lo", "hi", "center", "radius", "z", "count", "arrangement", "spacing", "jitter", "gap"});
+    rd.only(f, fp, {"shape", "lo", "hi", "center", "radius", "z", "count", "solid_fraction", "arrangement", "spacing",
+                    "jitter", "gap", "grading"});
     const RadiusDist dist = parse_radius(rd, g, path);
     const Region region = parse_region(rd, f, fp);
+    if (f["count"] && f["solid_fraction"])
+      rd.fail(Reader::join(fp, "count"), "give either count or " + Reader::join(fp, "solid_fraction") + ", not both");
     const long count = rd.integer(f, fp, "count", 1000, 1, 50000000);
     const std::string arrangement = rd.choice(f, fp, "arrangement", "lattice", {"lattice", "random"});
     if (arrangement == "lattice") {
-      if (f["gap"]) rd.fail(Reader::join(fp, "gap"), "applies to arrangement: random only");
+      for (const char* k : {"gap", "solid_fraction", "grading"})
+        if (f[k]) rd.fail(Reader::join(fp, k), "applies to arrangement: random only");
       const double spacing = rd.number(f, fp, "spacing", 2.1 * dist.max(), 2 * dist.max(), kMaxSceneLength);
       const double jitter = rd.number(f, fp, "jitter", 0.05 * (spacing - 2 * dist.max()) + 0.01 * dist.mean, 0,
                                       0.5 * spacing);
@@ -240,13 +276,34 @@ void parse_grains(const Reader& rd, Scenario& sc, const YAML::Node& g, const std
       for (const char* k : {"spacing", "jitter"})
         if (f[k]) rd.fail(Reader::join(fp, k), "applies to arrangement: lattice only");
       const double gap = rd.number(f, fp, "gap", 0.1 * dist.mean, 0, kMaxSceneLength);
-      const std::vector<double> drawn = draw_radii(dist, int(count), rng);
-      RandomFill fill = random_sites(region, drawn, 0.0, gap, 20000, rng);
-      if (long(fill.sites.size()) < count)
-        rd.fail(Reader::join(fp, "count"), std::to_string(count) +
-                                                " grains do not fit at random in the region (room found for " +
-                                                std::to_string(fill.sites.size()) +
-                                                " in 20000 draws each): make the region larger");
+      Grading grading;
+      const bool graded = bool(f["grading"]);
+      if (graded) grading = parse_grading(rd, f, fp, region, dist);
+      RandomFill fill;
+      if (f["solid_fraction"]) {
+        // The random close packing of spheres is 0.64; sequential addition jams near 0.38.
+        const double fraction = rd.number(f, fp, "solid_fraction", 0, 1e-6, 0.35);
+        const double mean_volume = 4.0 / 3.0 * kPi * std::pow(dist.mean, 3);
+        if (fraction * region_volume(region) / mean_volume > 5e7)
+          rd.fail(Reader::join(fp, "solid_fraction"), "would generate more than 50,000,000 grains in the region (" +
+                                                          region_keys(fp, region) + ")");
+        fill = random_fraction(region, dist, fraction, 0.0, gap, 20000, rng, graded ? &grading : nullptr);
+        double volume = 0;
+        for (const double r : fill.radii) volume += 4.0 / 3.0 * kPi * r * r * r;
+        if (fill.sites.empty() || volume < fraction * region_volume(region))
+          rd.fail(Reader::join(fp, "solid_fraction"),
+                  Reader::num_text(fraction) + " is not reached at random in the region (room found for " +
+                      std::to_string(fill.sites.size()) + " grains, a solid fraction of " +
+                      Reader::num_text(volume / region_volume(region)) + ", in 20000 draws each): make it smaller");
+      } else {
+        const std::vector<double> drawn = draw_radii(dist, int(count), rng);
+        fill = random_sites(region, drawn, 0.0, gap, 20000, rng, graded ? &grading : nullptr);
+        if (long(fill.sites.size()) < count)
+          rd.fail(Reader::join(fp, "count"), std::to_string(count) +
+                                                  " grains do not fit at random in the region (room found for " +
+                                                  std::to_string(fill.sites.size()) +
+                                                  " in 20000 draws each): make the region larger");
+      }
       pos = std::move(fill.sites);
       radii = std::move(fill.radii);
     }

@@ -2,7 +2,9 @@
 // inside its region, clear of the others by the gap, in the same places for
 // the same seed, sorted bottom-up; a region too small for the count is
 // reported; the scenario reads `arrangement: random` and refuses the
-// lattice's keys with it.
+// lattice's keys with it. A graded fill's grains follow its knobs (each
+// radius is a drawn one times the grading's scale at its place), a fill to a
+// solid fraction reaches it, and a grading that scales nothing changes no site.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -84,6 +86,94 @@ TEST(RandomFill, SameSeedSamePlacesAndFullRegionsReported) {
   EXPECT_LT(fill(9, 5000).sites.size(), 5000u);
 }
 
+rt::Grading mascot_grading() {
+  rt::Grading g;
+  g.surface = 0.30;
+  g.base = 0.0;
+  g.compaction = 0.5;
+  g.center_x = 0.05;
+  g.center_y = -0.02;
+  g.fine_depth = 0.06;
+  g.fine_radius = 0.15;
+  g.depth_rate = 0.2;
+  g.radial_rate = 0.1;
+  g.max_scale = 3;
+  g.mean_diameter = 0.02;
+  return g;
+}
+
+TEST(GradedFill, ScaleFollowsItsKnobs) {
+  const rt::Grading g = mascot_grading();
+  // Generated z = 0.6 maps to the surface (0.5 * 0.6); 0.48 to 0.24, the fine layer's bottom.
+  EXPECT_DOUBLE_EQ(g.scale(Vec3(0.05, -0.02, 0.6)), 1.0);
+  EXPECT_DOUBLE_EQ(g.scale(Vec3(0.05, -0.02, 0.48)), 1.0);
+  EXPECT_DOUBLE_EQ(g.scale(Vec3(0.15, -0.02, 0.48)), 1.0);  // 0.10 from the axis: inside the fine zone
+  // 0.10 m deeper than the fine layer (generated 0.2 m lower): the diameter grows by 0.2 * 0.10 = 0.02 m.
+  EXPECT_NEAR(g.scale(Vec3(0.05, -0.02, 0.28)), 2.0, 1e-12);
+  // 0.05 m beyond the fine zone: 0.1 * 0.05 = 0.005 m, a quarter of the diameter.
+  EXPECT_NEAR(g.scale(Vec3(0.25, -0.02, 0.48)), 1.25, 1e-12);
+  // Both add; the cap holds.
+  EXPECT_NEAR(g.scale(Vec3(0.25, -0.02, 0.28)), 2.25, 1e-12);
+  EXPECT_DOUBLE_EQ(g.scale(Vec3(0.05, -0.02, 0.0)), 3.0);
+}
+
+TEST(GradedFill, GrainsAreDrawnRadiiTimesTheScaleAtTheirPlace) {
+  const rt::Grading g = mascot_grading();
+  const rt::Region region = cylinder(0.35, 0.0, 0.62);
+  const rt::RadiusDist d{0.01, 0.3, 1.0};
+  std::mt19937_64 rng(11);
+  const double gap = 0.0005;
+  const rt::RandomFill f = rt::random_fraction(region, d, 0.12, 0.0, gap, 20000, rng, &g);
+  ASSERT_GT(f.sites.size(), 500u);
+  double volume = 0, unscaled_sum = 0, fine = 0, coarse = 0;
+  int n_fine = 0, n_coarse = 0;
+  for (size_t i = 0; i < f.sites.size(); ++i) {
+    const Vec3& p = f.sites[i];
+    const double r = f.radii[i], s = g.scale(p);
+    volume += 4.0 / 3.0 * M_PI * r * r * r;
+    // The drawn radius is within the distribution's cut.
+    ASSERT_GE(r / s, 0.007 - 1e-12);
+    ASSERT_LE(r / s, 0.013 + 1e-12);
+    unscaled_sum += r / s;
+    ASSERT_LE(std::hypot(p.x(), p.y()) + r, 0.35 + 1e-12);
+    ASSERT_GE(p.z() - r, -1e-12);
+    ASSERT_LE(p.z() + r, 0.62 + 1e-12);
+    if (s == 1.0) {
+      fine += r;
+      ++n_fine;
+    } else if (s == 3.0) {
+      coarse += r;
+      ++n_coarse;
+    }
+  }
+  for (size_t i = 0; i < f.sites.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      ASSERT_GE((f.sites[i] - f.sites[j]).norm(), f.radii[i] + f.radii[j] + gap - 1e-12);
+  // The drawn radii keep their mean; the fine zone has the distribution's sizes, the capped region three times them.
+  EXPECT_NEAR(unscaled_sum / f.sites.size(), 0.01, 3e-4);
+  ASSERT_GT(n_fine, 20);
+  ASSERT_GT(n_coarse, 20);
+  EXPECT_NEAR(fine / n_fine, 0.01, 6e-4);
+  EXPECT_NEAR(coarse / n_coarse, 0.03, 2e-3);
+  // The solid fraction is reached by the last grain and not passed by more than it.
+  const double target = 0.12 * rt::region_volume(region);
+  EXPECT_GE(volume, target);
+  EXPECT_LT(volume, target + 4.0 / 3.0 * M_PI * std::pow(0.039, 3));
+}
+
+TEST(GradedFill, AGradingThatScalesNothingChangesNoSite) {
+  rt::Grading g = mascot_grading();
+  g.max_scale = 1.0;
+  const rt::RadiusDist d{0.01, 0.3, 1.0};
+  const rt::Region region = cylinder(0.25, 0.0, 0.5);
+  std::mt19937_64 a(4), b(4);
+  const rt::RandomFill plain = rt::random_sites(region, rt::draw_radii(d, 2000, a), 0.0, 0.001, 20000, a);
+  const rt::RandomFill graded = rt::random_sites(region, rt::draw_radii(d, 2000, b), 0.0, 0.001, 20000, b, &g);
+  ASSERT_EQ(plain.sites.size(), 2000u);
+  EXPECT_EQ(plain.sites, graded.sites);
+  EXPECT_EQ(plain.radii, graded.radii);
+}
+
 TEST(RandomFill, ScenarioKeys) {
   const std::string base = R"(name: fill
 seed: 3
@@ -116,6 +206,29 @@ stages: [{name: s, duration: 0.001}]
   refused({"grains.0.fill.arrangement=hexagonal"}, "grains[0].fill.arrangement");
   refused({"grains.0.fill.arrangement=lattice", "grains.0.fill.gap=0.001"}, "grains[0].fill.gap");
   refused({"grains.0.fill.count=40000"}, "do not fit at random");
+  // Graded and solid-fraction fills.
+  std::string fraction = base;
+  fraction.replace(fraction.find("count: 400"), 10, "solid_fraction: 0.05");
+  const std::string fraction_path = ::testing::TempDir() + "/fill_fraction_test.yaml";
+  std::ofstream(fraction_path) << fraction;
+  const rt::Scenario sf = rt::load_scenario(
+      fraction_path, {"grains.0.fill.grading={surface: 0.2, fine_depth: 0.05, depth_rate: 0.3, max_scale: 2}"});
+  double volume = 0;
+  for (int i = 0; i < sf.model.n_grains; ++i) volume += 4.0 / 3.0 * M_PI * std::pow(sf.model.grain_radius[i], 3);
+  EXPECT_GE(volume, 0.05 * M_PI * 0.2 * 0.2 * 0.5);
+  const rt::Scenario sf_plain = rt::load_scenario(fraction_path);
+  EXPECT_LT(sf.model.n_grains, 0.8 * sf_plain.model.n_grains);  // the grains below the fine layer are larger
+  refused({"grains.0.fill.solid_fraction=0.05"}, "give either count or grains[0].fill.solid_fraction");
+  try {
+    rt::load_scenario(fraction_path, {"grains.0.fill.solid_fraction=0.34"});
+    ADD_FAILURE() << "accepted: a solid fraction of 0.34";
+  } catch (const rt::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is not reached at random"), std::string::npos) << e.what();
+  }
+  refused({"grains.0.fill.arrangement=lattice", "grains.0.fill.grading={surface: 0.2}"}, "grains[0].fill.grading");
+  refused({"grains.0.fill.grading={surface: 0.2, radial_rate: 0.1}"}, "grains[0].fill.grading.fine_radius");
+  refused({"grains.0.fill.grading={fine_depth: 0.1}"}, "grains[0].fill.grading.surface");
+  refused({"grains.0.fill.grading={surface: 0.2, max_scale: 0.5}"}, "grains[0].fill.grading.max_scale");
 }
 
 }  // namespace

@@ -48,7 +48,43 @@ struct RandomFill {
   std::vector<Vec3> sites;
   std::vector<double> radii;
 };
+
+// A graded fill (docs/scenes.md E.1, "Graded fills"): a grain's drawn radius is
+// multiplied by scale(p), p its generated position. The generated heights are
+// mapped to the settled bed's by z_bed = base + compaction (z - base); below
+// the fine layer (depth under `surface` beyond fine_depth) and beyond the fine
+// zone (horizontal distance from `center` beyond fine_radius) the mean
+// diameter grows by depth_rate and radial_rate per metre of excess:
+//   scale = min(max_scale, 1 + (depth_rate e_depth + radial_rate e_radial) / mean_diameter).
+struct Grading {
+  double surface = 0;        // z of the settled bed's surface, m
+  double base = 0;           // z of the fill's floor: the height map's fixed point, m
+  double compaction = 1;     // settled over generated height above `base`
+  double center_x = 0, center_y = 0;  // the fine zone's vertical axis, m
+  double fine_depth = 0;     // m below the surface
+  double fine_radius = 0;    // m around the axis (no radial growth when radial_rate = 0)
+  double depth_rate = 0;     // mean-diameter growth per metre of depth beyond the fine layer
+  double radial_rate = 0;    // mean-diameter growth per metre of distance beyond the fine zone
+  double max_scale = 1;      // largest radius factor
+  double mean_diameter = 0;  // of the drawn (unscaled) distribution, m
+  double scale(const Vec3& p) const;
+};
+
+// As above, with each grain's radius scaled by grading->scale at the place
+// drawn for it (the whole scaled sphere inside the region); grading = nullptr
+// is random_sites without grading (the same draws, the same sites).
 RandomFill random_sites(const Region& r, const std::vector<double>& radii, double margin, double gap, int attempts,
-                        std::mt19937_64& rng);
+                        std::mt19937_64& rng, const Grading* grading = nullptr);
+
+// A random fill to a solid fraction instead of a count: radii are drawn one at
+// a time from `dist` and placed as random_sites does (scaled by `grading` when
+// given) until the grains' volume reaches `fraction` of the region's. Fewer
+// grains (volume short of the target, reported by the caller) when one found
+// no room in `attempts` draws.
+RandomFill random_fraction(const Region& r, const RadiusDist& dist, double fraction, double margin, double gap,
+                           int attempts, std::mt19937_64& rng, const Grading* grading = nullptr);
+
+// The region's volume, m^3.
+double region_volume(const Region& r);
 
 }  // namespace rt

@@ -17,14 +17,13 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
 from plots import pyplot  # noqa: E402
-from stats import mean_sd  # noqa: E402
+from stats import mean_sd, paired_difference  # noqa: E402
 
 KEEP = os.path.join(ROOT, "results", "bench", "b4")
 # output key, label, margin, relative margin?
 OUTPUTS = [("speed_ratio", "speed ratio", 0.05, False),
            ("max_penetration", "max penetration (m)", 0.01, False),
            ("travel_distance", "travel distance (m)", 0.15, True)]
-T95 = {1: 12.706, 2: 4.303, 3: 3.182, 4: 2.776, 5: 2.571, 6: 2.447, 7: 2.365, 8: 2.306, 9: 2.262, 10: 2.228}
 
 
 def load(setting):
@@ -70,12 +69,7 @@ def main():
         for k, lab, margin, rel in OUTPUTS:
             a = [ref[r]["outcome"][k] for r in pairs]
             b = [runs[r]["outcome"][k] for r in pairs]
-            if rel:
-                d = [(y - x) / x for x, y in zip(a, b)]
-            else:
-                d = [y - x for x, y in zip(a, b)]
-            m = mean(d)
-            half = T95.get(len(d) - 1, 1.96) * sd(d) / math.sqrt(len(d)) if len(d) > 1 else float("inf")
+            m, half = paired_difference(a, b, rel)
             ok = abs(m) + half <= margin
             unit = ", difference relative" if rel else ""
             lines.append(f"| {lab}{unit} | {' / '.join(f'{x:.3g}' for x in a)} | {' / '.join(f'{y:.3g}' for y in b)} | "

@@ -27,6 +27,20 @@ def mean_sd(xs, missing=float("nan")):
     return d["mean"], d["sd"] if d["sd"] is not None else missing
 
 
+# Student's t, two-sided 95 %, by degrees of freedom (1.96 beyond the table).
+T95 = {1: 12.706, 2: 4.303, 3: 3.182, 4: 2.776, 5: 2.571, 6: 2.447, 7: 2.365, 8: 2.306, 9: 2.262, 10: 2.228,
+       11: 2.201, 12: 2.179, 13: 2.160, 14: 2.145, 15: 2.131}
+
+
+def paired_difference(ref, new, relative=False):
+    """(mean, half-width of the 95 % confidence interval) of the paired differences new - ref (relative:
+    (new - ref) / ref), Student's t; the half-width is infinite for a single pair."""
+    d = [(y - x) / x if relative else y - x for x, y in zip(ref, new)]
+    m, s = mean_sd(d, missing=float("inf"))
+    half = T95.get(len(d) - 1, 1.96) * s / math.sqrt(len(d)) if len(d) > 1 else float("inf")
+    return m, half
+
+
 def line_fit(x, y):
     """y = a + b x by least squares: (a, b)."""
     b, a = np.polyfit(np.asarray(x, float), np.asarray(y, float), 1)

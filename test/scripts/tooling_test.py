@@ -36,6 +36,16 @@ class Statistics(unittest.TestCase):
         self.assertEqual(stats.mean_sd([2.0], missing=float("inf"))[1], float("inf"))
         self.assertEqual(stats.mean_sd([1.0, 3.0]), (2.0, math.sqrt(2.0)))
 
+    def test_paired_difference_by_students_t(self):
+        # Differences 1, 2, 3: mean 2, SD 1, half-width t(2) / sqrt(3).
+        m, half = stats.paired_difference([1.0, 1.0, 1.0], [2.0, 3.0, 4.0])
+        self.assertAlmostEqual(m, 2.0)
+        self.assertAlmostEqual(half, 4.303 / math.sqrt(3))
+        m, half = stats.paired_difference([2.0, 4.0], [3.0, 6.0], relative=True)
+        self.assertAlmostEqual(m, 0.5)
+        self.assertEqual(half, 0.0)  # two equal relative differences
+        self.assertEqual(stats.paired_difference([1.0], [2.0]), (1.0, float("inf")))
+
     def test_line_and_power_fits_recover_exact_data(self):
         a, b = stats.line_fit([0, 1, 2, 3], [1, 3, 5, 7])
         self.assertAlmostEqual(a, 1.0, places=12)

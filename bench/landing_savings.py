@@ -1,0 +1,267 @@
+#!/usr/bin/python3
+"""Resolution where the lander is (docs/bench/landing.md): paired landings on independent beds.
+
+  bench/landing_savings.py run SETTING [SETTING ...] [--beds NAME,...] [--threads N]
+  bench/landing_savings.py report     docs/bench/landing_report.md, landing_savings.png, savings.csv
+  bench/landing_savings.py list       the settings and beds, and which runs are kept
+
+Beds: the three independent preparations of the 30 cm moderate bed
+(config/beds/mascot_moderate_d30{,_s2,_s3}.bed), each as prepared (repeat 0) and rotated and
+aimed as a perturbed bed (docs/scenes.md A.7): eight paired beds, s1r0 ... s3r1.
+
+Settings (SETTINGS below): `whole` is the reference, the model with nothing skipped (the whole bed
+free, no sleeping, no free flight, the scene's stiffness and time step); `default` is the shipped
+landing (active zone 0.45 m); the others are savings. A graded setting lands on the graded bed of
+the same preparation (config/beds/mascot_moderate_d30_ga*.bed, docs/scenes.md E.1) with k_n and
+Delta-t fixed at the values the k_n rule gives on the whole bed of that preparation (its mean grain
+mass and smallest radius, docs/model.md section 4): the reference's contact law, which the rule
+would otherwise stiffen with the graded bed's larger mean mass. A softer setting changes x_max
+(k_n by (0.01 / x_max)^2) and the steps per contact.
+
+Each finished run's summary.json is kept as results/bench/landing/SETTING_BED.json; a kept run is
+not run again (the study resumes on any machine once they are committed). Runs go one at a time on
+--threads threads (default 1: two studies side by side fill two cores).
+Environment: REGOLITH_BIN (default build/devel/lib/regolith_twin).
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
+from plots import pyplot, save_figure  # noqa: E402
+from stats import mean_sd, paired_difference  # noqa: E402
+
+KEEP = os.path.join(ROOT, "results", "bench", "landing")
+OUT = os.path.join(ROOT, "out", "bench", "landing")
+DOCS = os.path.join(ROOT, "docs", "bench")
+SCENE = os.path.join(ROOT, "config", "mascot_landing.yaml")
+MATERIAL = "moderate"
+# name -> (preparation suffix, repeat)
+BEDS = {"s1r0": ("", 0), "s1r1": ("", 1), "s1r2": ("", 2), "s2r0": ("_s2", 0), "s2r1": ("_s2", 1),
+        "s2r2": ("_s2", 2), "s3r0": ("_s3", 0), "s3r1": ("_s3", 1)}
+WHOLE = ["landing.active_radius=0"]
+# The scene's contact rule (config/mascot_landing.yaml): v_max, x_max (of the smallest radius), steps per contact.
+V_MAX, X_MAX, STEPS = 0.19, 0.01, 30
+# name -> {"grading": bed suffix or "", "sets": [--set ...], "profile": name or None, "x_max", "steps", "what"}
+SETTINGS = {}
+
+
+def setting(name, what, grading="", sets=(), profile=None, x_max=X_MAX, steps=STEPS):
+    SETTINGS[name] = {"grading": grading, "sets": list(sets), "profile": profile, "x_max": x_max, "steps": steps,
+                      "what": what}
+
+
+setting("whole", "reference: the whole bed free, every saving off", sets=WHOLE)
+setting("default", "today's default: active zone 0.45 m")
+setting("sleep", "whole bed, quiet cells sleep (profile sleep)", profile="sleep")
+setting("ga", "graded bed (ga), whole bed free", grading="_ga", sets=WHOLE)
+setting("ga_zone", "graded bed (ga) and the active zone 0.45 m", grading="_ga")
+setting("ga_sleep", "graded bed (ga), quiet cells sleep", grading="_ga", profile="sleep")
+for xm, n in ((0.02, 30), (0.03, 20), (0.05, 15)):
+    tag = "x%02d_n%d" % (round(xm * 100), n)
+    setting(tag, "whole bed, x_max %g, %d steps per contact" % (xm, n), sets=WHOLE, x_max=xm, steps=n)
+    setting("ga_" + tag, "graded bed (ga), x_max %g, %d steps per contact" % (xm, n), grading="_ga", sets=WHOLE,
+            x_max=xm, steps=n)
+
+# output key, label, margin, relative margin?  (B4, docs/bench/b4_landing.md)
+OUTPUTS = [("speed_ratio", "speed ratio", 0.05, False),
+           ("max_penetration", "max penetration (m)", 0.01, False),
+           ("travel_distance", "travel distance", 0.15, True)]
+
+
+def bed_file(prep, grading=""):
+    return "beds/mascot_%s_d30%s%s.bed" % (MATERIAL, grading, prep)
+
+
+def read_bed(path):
+    """Radii of a float32 bed snapshot (docs/model.md section 14)."""
+    data = open(path, "rb").read()
+    if data[:8] != b"RGTWBED1":
+        raise SystemExit("%s: not a float32 bed snapshot" % path)
+    n = int(np.frombuffer(data[8:16], dtype=np.uint64)[0])
+    return np.frombuffer(data[16:16 + 16 * n], dtype=np.float32).reshape(n, 4)[:, 3].astype(float)
+
+
+def pinned_contact(prep, x_max, steps, density=2430.0):
+    """k_n and Delta-t of the rule on the whole (ungraded) bed of this preparation."""
+    r = read_bed(os.path.join(ROOT, "config", bed_file(prep)))
+    m_p = float(np.mean(4.0 / 3.0 * math.pi * r ** 3 * density))
+    kn = m_p * (V_MAX / (x_max * float(r.min()))) ** 2
+    return kn, math.pi * math.sqrt(m_p / (2 * kn)) / steps
+
+
+def command(bin_dir, name, bed, threads):
+    st, (prep, repeat) = SETTINGS[name], BEDS[bed]
+    cmd = [os.path.join(bin_dir, "regolith_sim"), SCENE, "--out", os.path.join(OUT, "%s_%s" % (name, bed)),
+           "--threads", str(threads), "--quiet"]
+    if st["profile"]:
+        cmd += ["--profile", st["profile"]]
+    sets = ["landing.repeat=%d" % repeat, "grains.0.file=%s" % bed_file(prep, st["grading"])] + st["sets"]
+    if st["grading"]:
+        kn, dt = pinned_contact(prep, st["x_max"], st["steps"])
+        sets += ["contact.kn=%.10g" % kn, "contact.dt=%.10g" % dt]
+    else:
+        sets += ["contact.x_max=%g" % st["x_max"], "contact.steps_per_contact=%d" % st["steps"]]
+    for s in sets:
+        cmd += ["--set", s]
+    return cmd
+
+
+def run(names, beds, threads):
+    bin_dir = os.environ.get("REGOLITH_BIN", os.path.join(ROOT, "build", "devel", "lib", "regolith_twin"))
+    os.makedirs(KEEP, exist_ok=True)
+    for name in names:
+        for bed in beds:
+            keep = os.path.join(KEEP, "%s_%s.json" % (name, bed))
+            if os.path.exists(keep):
+                continue
+            cmd = command(bin_dir, name, bed, threads)
+            p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+            out = cmd[cmd.index("--out") + 1]
+            if p.returncode != 0 or not os.path.exists(os.path.join(out, "summary.json")):
+                print("%s %s: exit %d: %s" % (name, bed, p.returncode, p.stderr.strip()[-400:]), flush=True)
+                continue
+            s = json.load(open(os.path.join(out, "summary.json")))
+            s["bench"] = {"setting": name, "bed": bed, "command": " ".join(os.path.relpath(c, ROOT) if c.startswith(ROOT)
+                                                                          else c for c in cmd), "threads": threads}
+            with open(keep + ".tmp", "w") as f:
+                json.dump(s, f, indent=1)
+            os.replace(keep + ".tmp", keep)
+            o = s["outcome"]
+            print("%s %s: speed ratio %.3f, penetration %.4f m, travel %.2f m, %.0f s" % (
+                name, bed, o["speed_ratio"], o["max_penetration"], o["travel_distance"], s["run"]["wall_seconds"]),
+                flush=True)
+
+
+def load(name):
+    runs = {}
+    for bed in BEDS:
+        f = os.path.join(KEEP, "%s_%s.json" % (name, bed))
+        if os.path.exists(f):
+            runs[bed] = json.load(open(f))
+    return runs
+
+
+def compare(ref, runs, base):
+    """The setting's paired figures: wall-time ratio to `base` (today's default) and, per output,
+    the mean difference from the reference with its 95 % CI."""
+    pairs = [b for b in BEDS if b in ref and b in runs]
+    row = {"beds": len(pairs)}
+    wpairs = [b for b in BEDS if b in base and b in runs]
+    if wpairs:
+        ratios = [base[b]["run"]["wall_seconds"] / runs[b]["run"]["wall_seconds"] for b in wpairs]
+        row["wall_ratio"] = (mean_sd([base[b]["run"]["wall_seconds"] for b in wpairs])[0] /
+                             mean_sd([runs[b]["run"]["wall_seconds"] for b in wpairs])[0])
+        row["wall_ratio_min"], row["wall_ratio_max"] = min(ratios), max(ratios)
+    row["wall"] = mean_sd([runs[b]["run"]["wall_seconds"] for b in runs])[0]
+    for key, _, margin, rel in OUTPUTS:
+        if len(pairs) < 1:
+            continue
+        m, half = paired_difference([ref[b]["outcome"][key] for b in pairs], [runs[b]["outcome"][key] for b in pairs],
+                                    rel)
+        row[key] = (m, half, margin, abs(m) + half <= margin)
+    return row
+
+
+def report():
+    ref, base = load("whole"), load("default")
+    rows = {name: compare(ref, load(name), base) for name in SETTINGS if name != "whole" and load(name)}
+    lines = ["<!-- generated by bench/landing_savings.py report -->", ""]
+    if ref:
+        vals = {k: [ref[b]["outcome"][k] for b in ref] for k, *_ in OUTPUTS}
+        lines += ["Reference (`whole`), %d beds: " % len(ref) + "; ".join(
+            "%s %.3g ± %.2g (SD)" % (lab, *mean_sd(vals[k])) for k, lab, *_ in OUTPUTS) +
+            "; wall time %.0f s per landing." % mean_sd([ref[b]["run"]["wall_seconds"] for b in ref])[0], ""]
+    lines += ["| setting | what | beds | wall time (s) | faster than `default` (range) | " +
+              " | ".join("%s: difference, 95 %% CI (margin ±%g%s)" % (lab, mg, " relative" if rel else "")
+                         for _, lab, mg, rel in OUTPUTS) + " |",
+              "|---|---|---|---|---|" + "---|" * len(OUTPUTS)]
+    for name, row in rows.items():
+        cells = ["`%s`" % name, SETTINGS[name]["what"], str(row["beds"]), "%.0f" % row["wall"]]
+        cells.append("%.2f× (%.2f–%.2f)" % (row["wall_ratio"], row["wall_ratio_min"], row["wall_ratio_max"])
+                     if "wall_ratio" in row else "–")
+        for key, *_ in OUTPUTS:
+            if key in row:
+                m, half, margin, ok = row[key]
+                cells.append("%+.3g [%+.3g, %+.3g] %s" % (m, m - half, m + half, "✓" if ok else "✗"))
+            else:
+                cells.append("–")
+        lines.append("| " + " | ".join(cells) + " |")
+    with open(os.path.join(DOCS, "landing_report.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    with open(os.path.join(DOCS, "savings.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        head = ["setting", "beds", "wall_seconds", "wall_ratio_to_default", "wall_ratio_min", "wall_ratio_max"]
+        for key, *_ in OUTPUTS:
+            head += [key + "_diff", key + "_ci_lo", key + "_ci_hi", key + "_margin", key + "_within"]
+        w.writerow(head)
+        for name, row in rows.items():
+            r = [name, row["beds"], "%.1f" % row["wall"]] + (
+                ["%.3f" % row[k] for k in ("wall_ratio", "wall_ratio_min", "wall_ratio_max")] if "wall_ratio" in row
+                else ["NA"] * 3)
+            for key, *_ in OUTPUTS:
+                if key in row:
+                    m, half, margin, ok = row[key]
+                    r += ["%.5g" % m, "%.5g" % (m - half), "%.5g" % (m + half), "%g" % margin, int(ok)]
+                else:
+                    r += ["NA"] * 5
+            w.writerow(r)
+    draw(rows, mean_sd([ref[b]["run"]["wall_seconds"] for b in ref])[0] if ref else None)
+
+
+def draw(rows, ref_wall):
+    plt = pyplot()
+    fig, axs = plt.subplots(1, len(OUTPUTS), figsize=(4.2 * len(OUTPUTS), 3.6))
+    for ax, (key, lab, margin, rel) in zip(axs, OUTPUTS):
+        for name, row in rows.items():
+            if key not in row:
+                continue
+            m, half, _, _ = row[key]
+            ax.errorbar([row["wall"]], [m], yerr=[[half], [half]] if math.isfinite(half) else None, fmt="o",
+                        capsize=3, label=name)
+        ax.axhspan(-margin, margin, color="g", alpha=0.1)
+        if ref_wall and ref_wall == ref_wall:
+            ax.plot([ref_wall], [0], "ks", label="whole (reference)")
+        ax.axhline(0, color="k", lw=0.5)
+        ax.set_xscale("log")
+        ax.set_xlabel("wall time per landing (s)")
+        ax.set_title("%s: difference%s" % (lab, " (relative)" if rel else ""), fontsize=9)
+    axs[0].legend(fontsize=6)
+    save_figure(fig, os.path.join(DOCS, "landing_savings.png"))
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("cmd", choices=["run", "report", "list"])
+    p.add_argument("settings", nargs="*")
+    p.add_argument("--beds", default=",".join(BEDS))
+    p.add_argument("--threads", type=int, default=1)
+    a = p.parse_args()
+    beds = [b for b in a.beds.split(",") if b]
+    for b in beds:
+        if b not in BEDS:
+            raise SystemExit("landing_savings: unknown bed '%s' (known: %s)" % (b, ", ".join(BEDS)))
+    for s in a.settings:
+        if s not in SETTINGS:
+            raise SystemExit("landing_savings: unknown setting '%s' (known: %s)" % (s, ", ".join(SETTINGS)))
+    if a.cmd == "run":
+        if not a.settings:
+            raise SystemExit("landing_savings: name the settings to run")
+        run(a.settings, beds, a.threads)
+    elif a.cmd == "report":
+        report()
+    else:
+        for name, st in SETTINGS.items():
+            done = [b for b in BEDS if os.path.exists(os.path.join(KEEP, "%s_%s.json" % (name, b)))]
+            print("%-14s %-55s %d/%d kept" % (name, st["what"], len(done), len(BEDS)))
+
+
+if __name__ == "__main__":
+    main()

@@ -174,6 +174,31 @@ TEST(GradedFill, AGradingThatScalesNothingChangesNoSite) {
   EXPECT_EQ(plain.radii, graded.radii);
 }
 
+// Fills without grading draw as before grading existed: these sums are those of
+// the same fill made by the build before (a change of the random sequence moves
+// them at the first digit; 1e-12 leaves room for floating-point contraction).
+TEST(RandomFill, UngradedFillsDrawAsBeforeGrading) {
+  const rt::Region r = cylinder(0.25, 0.0, 0.5);
+  std::mt19937_64 rng(2018);
+  const rt::RadiusDist d{0.01, 0.33, 1.0};
+  const rt::RandomFill f = rt::random_sites(r, rt::draw_radii(d, 3000, rng), 0.0, 0.001, 20000, rng);
+  ASSERT_EQ(f.sites.size(), 3000u);
+  Vec3 sum = Vec3::Zero();
+  double sr = 0;
+  for (size_t i = 0; i < f.sites.size(); ++i) {
+    sum += f.sites[i];
+    sr += f.radii[i];
+  }
+  EXPECT_NEAR(sum.x(), 0.16790911646944043, 1e-12);
+  EXPECT_NEAR(sum.y(), 0.72640716912785341, 1e-12);
+  EXPECT_NEAR(sum.z(), 746.0000539227018, 1e-9);
+  EXPECT_NEAR(sr, 29.930168318708819, 1e-12);
+  EXPECT_NEAR(f.sites[0].x(), 0.0077812660416528602, 1e-15);
+  EXPECT_NEAR(f.sites[0].y(), -0.23539440931717442, 1e-15);
+  EXPECT_NEAR(f.sites[0].z(), 0.010689255119449714, 1e-15);
+  EXPECT_NEAR(f.radii[0], 0.0073710498516073291, 1e-15);
+}
+
 TEST(RandomFill, ScenarioKeys) {
   const std::string base = R"(name: fill
 seed: 3

@@ -31,11 +31,10 @@ import os
 import subprocess
 import sys
 
-import numpy as np
-
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
 from plots import pyplot, save_figure  # noqa: E402
+from bed_file import rule_contact  # noqa: E402
 from stats import mean_sd, paired_difference  # noqa: E402
 
 KEEP = os.path.join(ROOT, "results", "bench", "landing")
@@ -80,21 +79,9 @@ def bed_file(prep, grading=""):
     return "beds/mascot_%s_d30%s%s.bed" % (MATERIAL, grading, prep)
 
 
-def read_bed(path):
-    """Radii of a float32 bed snapshot (docs/model.md section 14)."""
-    data = open(path, "rb").read()
-    if data[:8] != b"RGTWBED1":
-        raise SystemExit("%s: not a float32 bed snapshot" % path)
-    n = int(np.frombuffer(data[8:16], dtype=np.uint64)[0])
-    return np.frombuffer(data[16:16 + 16 * n], dtype=np.float32).reshape(n, 4)[:, 3].astype(float)
-
-
 def pinned_contact(prep, x_max, steps, density=2430.0):
     """k_n and Delta-t of the rule on the whole (ungraded) bed of this preparation."""
-    r = read_bed(os.path.join(ROOT, "config", bed_file(prep)))
-    m_p = float(np.mean(4.0 / 3.0 * math.pi * r ** 3 * density))
-    kn = m_p * (V_MAX / (x_max * float(r.min()))) ** 2
-    return kn, math.pi * math.sqrt(m_p / (2 * kn)) / steps
+    return rule_contact(os.path.join(ROOT, "config", bed_file(prep)), V_MAX, x_max, steps, density)
 
 
 def command(bin_dir, name, bed, threads):

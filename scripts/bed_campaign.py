@@ -5,6 +5,9 @@
                                                   against the solid fraction of the generation region
   bed_campaign.py BIN OUT DOCS prepare [BED...]  the shipped beds (config/beds/BED.bed), three seeds of
                                                   the 30 cm MASCOT beds and of the sampler bed
+  bed_campaign.py BIN OUT DOCS creep [BED...]    how far a prepared MASCOT bed's surface moves when left
+                                                  alone for a landing's duration (default: the graded beds
+                                                  and their whole beds)
   bed_campaign.py BIN OUT DOCS report            DOCS/study.md, study.png and DOCS/prepared.md
 
 A small MASCOT-like bed (config/validation/bed_small.yaml: the MASCOT grains, walls and
@@ -28,6 +31,7 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
 import campaign_cli  # noqa: E402
+from bed_file import rule_contact, surface  # noqa: E402
 from plots import pyplot  # noqa: E402
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
@@ -49,6 +53,9 @@ SAMPLER_R = 0.15      # sampler container radius, m
 PUBLISHED = {"mascot_gravel_d15": 28375, "mascot_gravel_d30": 58454, "mascot_gravel_d40": 78176,
              "mascot_moderate_d15": 31082, "mascot_moderate_d30": 62551, "mascot_moderate_d40": 83097,
              "sampler_gravel": 101657}
+CREEP = os.path.join(ROOT, "config", "validation", "bed_creep.yaml")
+CREEP_ZONE = 0.35     # the surface is sampled within this distance of the axis (the graded beds' fine zone), m
+CREEP_CELL = 0.04     # ... on square cells of this side (two mean diameters), m
 CORE_WALL = 0.05      # the core region keeps this far from the side wall, m
 CORE_FLOOR = 0.03     # ... from the floor and from the pile's top, m
 
@@ -281,6 +288,44 @@ def report(docs):
     print("report: %s" % path)
 
 
+def creep(bin_dir, out, docs, names):
+    """Each MASCOT bed in the creep scene (config/validation/bed_creep.yaml): the landing's relaxation,
+    then 10 s alone; the surface's height within CREEP_ZONE of the axis before and after the 10 s. A
+    graded bed runs at the k_n and dt of the rule on the whole bed of its preparation."""
+    known = beds()
+    names = names or [n for n in known if "_d30_ga" in n] + [n.replace("_ga", "") for n in known if "_d30_ga" in n]
+    campaign_cli.check_names(names, known, "bed")
+    for name in names:
+        if not name.startswith("mascot_"):
+            raise SystemExit("creep: %s is not a MASCOT bed" % name)
+        keep = os.path.join(docs, "creep", name)
+        if campaign_cli.kept(keep, "BEDS_RERUN") is not None:
+            continue
+        bed = os.path.join(ROOT, "config", "beds", name + ".bed")
+        if not os.path.exists(bed):
+            print("%s: not prepared yet (scripts/validate_beds prepare %s)" % (name, name), flush=True)
+            continue
+        mat = name.split("_")[1]
+        ov = ["materials.regolith.preset=%s" % mat, "materials.container.preset=%s" % mat,
+              "grains.0.file=../beds/%s.bed" % name]
+        if "_ga" in name:
+            kn, dt = rule_contact(os.path.join(ROOT, "config", "beds", name.replace("_ga", "") + ".bed"), 0.19, 0.01, 30,
+                                  2430.0)
+            ov += ["contact.kn=%.10g" % kn, "contact.dt=%.10g" % dt]
+        run_dir = os.path.join(out, "creep", name)
+        s = campaign_cli.run_and_keep(bin_dir, CREEP, run_dir, keep, ov, {"bed": name}, extra=["--stage-snapshots"])
+        if s is None:
+            continue
+        before, cells = surface(os.path.join(run_dir, "relax.bed"), CREEP_ZONE, CREEP_CELL)
+        after, _ = surface(os.path.join(run_dir, "free.bed"), CREEP_ZONE, CREEP_CELL)
+        s["creep"] = {"surface_before": before, "surface_after": after, "drift": after - before, "cells": cells,
+                      "free_seconds": 10.0, "mean_radius": 0.01, "drift_over_mean_radius": (after - before) / 0.01}
+        with open(os.path.join(keep, "summary.json"), "w") as f:
+            json.dump(s, f, indent=1)
+        print("%s: surface %.5f -> %.5f m over 10 s (%.3f mean radii; %.0f s)" % (
+            name, before, after, (after - before) / 0.01, s["campaign"]["wall_seconds"]), flush=True)
+
+
 def report_prepared(docs):
     """DOCS/prepared.md: every prepared bed against its published count (and the f = 0.12 trial)."""
     lines = ["# Shipped beds against the published counts", "",
@@ -309,6 +354,23 @@ def report_prepared(docs):
                 b.get("packing", float("nan")), b.get("bulk_density", float("nan")), rest,
                 "%.0f kB" % (b["snapshot_bytes"] / 1e3) if b.get("snapshot_bytes") else "–",
                 s["campaign"]["wall_seconds"]))
+    root = os.path.join(docs, "creep")
+    rows = []
+    for name in sorted(os.listdir(root)) if os.path.isdir(root) else []:
+        p = os.path.join(root, name, "summary.json")
+        c = json.load(open(p)).get("creep") if os.path.exists(p) else None
+        if c:
+            rows.append("| `%s` | %.4f | %.4f | %+.2f mm | %+.3f | %s |" % (
+                name, c["surface_before"], c["surface_after"], 1e3 * c["drift"], c["drift_over_mean_radius"],
+                "yes" if abs(c["drift_over_mean_radius"]) <= 0.1 else "no"))
+    if rows:
+        lines += ["", "## Creep", "",
+                  "`scripts/validate_beds creep`: each bed as a landing loads it (the landing's relaxation), then "
+                  "10 s alone under the scene's gravity; the surface is the mean over 4 cm cells within 0.35 m of "
+                  "the axis of the highest grain top in each (graded beds at the whole bed's k_n and Δt). "
+                  "Criterion: the surface moves by at most 0.1 mean radius (1 mm).", "",
+                  "| bed | surface before (m) | after 10 s (m) | drift | drift / mean radius | within 0.1 |",
+                  "|---|---|---|---|---|---|"] + rows
     with open(os.path.join(docs, "prepared.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("report: %s" % os.path.join(docs, "prepared.md"))
@@ -320,6 +382,8 @@ def main():
         study(bin_dir, out, docs, names)
     elif cmd == "prepare":
         prepare(bin_dir, out, docs, names)
+    elif cmd == "creep":
+        creep(bin_dir, out, docs, names)
     elif cmd == "report":
         report(docs)
         report_prepared(docs)

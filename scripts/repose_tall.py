@@ -36,6 +36,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, ".."))
 sys.path.insert(0, os.path.join(HERE, "lib"))
 import repose_angle  # noqa: E402
+from bed_file import read_snapshot  # noqa: E402
 from plots import pyplot, save_figure  # noqa: E402
 
 DOCS = os.path.join(ROOT, "results", "repose")
@@ -77,16 +78,6 @@ def run_name(material, pour, seed):
 PLAN = [("moderate", "near", 11), ("gravel", "near", 11), ("moderate", "high", 11), ("moderate", "near", 12),
         ("moderate", "near", 13), ("gravel", "high", 11)]
 RUNS = {run_name(*p): p for p in PLAN}
-
-
-def read_snapshot(path):
-    """(x, y, z, r) of the free grains of a float32 bed snapshot (docs/model.md §14)."""
-    data = open(path, "rb").read()
-    if data[:8] != b"RGTWBED1":
-        raise SystemExit("%s: not a float32 bed snapshot" % path)
-    n = int(np.frombuffer(data[8:16], dtype=np.uint64)[0])
-    rec = np.frombuffer(data[16:16 + 16 * n], dtype=np.float32).reshape(n, 4).astype(float)
-    return rec[:, 0], rec[:, 1], rec[:, 2], rec[:, 3]
 
 
 def measure(final, R):

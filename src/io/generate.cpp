@@ -85,7 +85,7 @@ class Rsa {
   // is ri, or ri scaled at the drawn place when graded. The placed radius, or 0.
   double place(double ri, int attempts, std::mt19937_64& rng) {
     const double keep = ri + margin_;  // distance from every side
-    for (int t = 0; t < attempts; ++t) {
+    for (int t = 0; t < attempts;) {
       Vec3 p;
       if (r_.shape == RegionShape::Cylinder) {
         const double rad = r_.radius - keep;
@@ -97,7 +97,12 @@ class Rsa {
         p.y() = r_.lo.y() + keep + (r_.hi.y() - r_.lo.y() - 2 * keep) * u01_(rng);
       }
       p.z() = r_.lo.z() + keep + (r_.hi.z() - r_.lo.z() - 2 * keep) * u01_(rng);
-      const double rp = grading_ ? ri * grading_->scale(p) : ri;
+      const double scale = grading_ ? grading_->scale(p) : 1.0;
+      // Graded: a place is kept with probability 1/scale^3 (not counted as an attempt), so that the
+      // grains' number density falls as their volume grows and the solid fraction stays uniform.
+      if (scale > 1 && u01_(rng) * scale * scale * scale > 1) continue;
+      ++t;
+      const double rp = ri * scale;
       if (grading_ && !inside(p, rp + margin_)) continue;
       int c[3];
       cell_of(p, c);

@@ -161,6 +161,47 @@ TEST(GradedFill, GrainsAreDrawnRadiiTimesTheScaleAtTheirPlace) {
   EXPECT_LT(volume, target + 4.0 / 3.0 * M_PI * std::pow(0.039, 3));
 }
 
+// The grains' number density falls as 1/scale^3 where they grow, so that the
+// solid fraction is the same in the fine and the coarse part of a fill (a bed
+// poured from it then settles to the same height everywhere). Box 0.4 x 0.4 x
+// 0.6 m, grains of 5 mm: twice that size below z = 0.25 m, drawn size above
+// 0.3 m; the fractions are compared in interior boxes kept 2 cm from the sides
+// (without the 1/scale^3 the coarse part would hold about 8 times the fraction).
+TEST(GradedFill, SolidFractionIsUniformWhereGrainsGrow) {
+  rt::Grading g;
+  g.surface = 0.6;
+  g.fine_depth = 0.3;
+  g.depth_rate = 1.0;
+  g.max_scale = 2;
+  g.mean_diameter = 0.01;
+  rt::Region box;
+  box.lo = Vec3(0, 0, 0);
+  box.hi = Vec3(0.4, 0.4, 0.6);
+  std::mt19937_64 rng(21);
+  const rt::RandomFill f = rt::random_fraction(box, rt::RadiusDist{0.005, 0.2, 1.0}, 0.15, 0.0, 0.0002, 20000, rng, &g);
+  double v_fine = 0, v_coarse = 0;
+  int n_fine = 0, n_coarse = 0;
+  for (size_t i = 0; i < f.sites.size(); ++i) {
+    const Vec3& p = f.sites[i];
+    if (p.x() < 0.02 || p.x() > 0.38 || p.y() < 0.02 || p.y() > 0.38) continue;
+    const double v = 4.0 / 3.0 * M_PI * std::pow(f.radii[i], 3);
+    if (p.z() >= 0.32 && p.z() <= 0.58) {
+      v_fine += v;
+      ++n_fine;
+    } else if (p.z() >= 0.02 && p.z() <= 0.25) {
+      v_coarse += v;
+      ++n_coarse;
+    }
+  }
+  const double a = 0.36 * 0.36;
+  ASSERT_GT(n_coarse, 300);
+  EXPECT_GT(n_fine, 6 * n_coarse);  // about 8 times as many per volume
+  // Inside, both a little above the whole box's 0.15 (no centre lies within a radius of its sides).
+  const double fine = v_fine / (a * 0.26), coarse = v_coarse / (a * 0.23);
+  EXPECT_NEAR(fine, 0.155, 0.01);
+  EXPECT_NEAR(coarse / fine, 1.0, 0.08);
+}
+
 TEST(GradedFill, AGradingThatScalesNothingChangesNoSite) {
   rt::Grading g = mascot_grading();
   g.max_scale = 1.0;
@@ -242,7 +283,7 @@ stages: [{name: s, duration: 0.001}]
   for (int i = 0; i < sf.model.n_grains; ++i) volume += 4.0 / 3.0 * M_PI * std::pow(sf.model.grain_radius[i], 3);
   EXPECT_GE(volume, 0.05 * M_PI * 0.2 * 0.2 * 0.5);
   const rt::Scenario sf_plain = rt::load_scenario(fraction_path);
-  EXPECT_LT(sf.model.n_grains, 0.8 * sf_plain.model.n_grains);  // the grains below the fine layer are larger
+  EXPECT_LT(sf.model.n_grains, 0.9 * sf_plain.model.n_grains);  // the grains below the fine layer are larger
   refused({"grains.0.fill.solid_fraction=0.05"}, "give either count or grains[0].fill.solid_fraction");
   try {
     rt::load_scenario(fraction_path, {"grains.0.fill.solid_fraction=0.34"});

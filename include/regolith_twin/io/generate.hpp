@@ -71,8 +71,10 @@ struct Grading {
 };
 
 // As above, with each grain's radius scaled by grading->scale at the place
-// drawn for it (the whole scaled sphere inside the region); grading = nullptr
-// is random_sites without grading (the same draws, the same sites).
+// drawn for it (the whole scaled sphere inside the region); a place is kept
+// with probability 1/scale^3, so that the solid fraction stays uniform where
+// the grains grow. grading = nullptr is random_sites without grading (the
+// same draws, the same sites).
 RandomFill random_sites(const Region& r, const std::vector<double>& radii, double margin, double gap, int attempts,
                         std::mt19937_64& rng, const Grading* grading = nullptr);
 

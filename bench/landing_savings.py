@@ -63,11 +63,14 @@ setting("sleep", "whole bed, quiet cells sleep (profile sleep)", profile="sleep"
 setting("ga", "graded bed (ga), whole bed free", grading="_ga", sets=WHOLE)
 setting("ga_zone", "graded bed (ga) and the active zone 0.45 m", grading="_ga")
 setting("ga_sleep", "graded bed (ga), quiet cells sleep", grading="_ga", profile="sleep")
+setting("gd", "graded bed in depth only (gd), whole bed free", grading="_gd", sets=WHOLE)
+setting("gd_zone", "graded bed in depth only (gd) and the active zone 0.45 m", grading="_gd")
 for xm, n in ((0.02, 30), (0.03, 20), (0.05, 15)):
     tag = "x%02d_n%d" % (round(xm * 100), n)
     setting(tag, "whole bed, x_max %g, %d steps per contact" % (xm, n), sets=WHOLE, x_max=xm, steps=n)
-    setting("ga_" + tag, "graded bed (ga), x_max %g, %d steps per contact" % (xm, n), grading="_ga", sets=WHOLE,
-            x_max=xm, steps=n)
+    for g in ("ga", "gd"):
+        setting("%s_%s" % (g, tag), "graded bed (%s), x_max %g, %d steps per contact" % (g, xm, n), grading="_" + g,
+                sets=WHOLE, x_max=xm, steps=n)
 
 # output key, label, margin, relative margin?  (B4, docs/bench/b4_landing.md)
 OUTPUTS = [("speed_ratio", "speed ratio", 0.05, False),
@@ -247,7 +250,7 @@ def main():
     else:
         for name, st in SETTINGS.items():
             done = [b for b in BEDS if os.path.exists(os.path.join(KEEP, "%s_%s.json" % (name, b)))]
-            print("%-14s %-55s %d/%d kept" % (name, st["what"], len(done), len(BEDS)))
+            print("%-14s %-58s %d/%d kept" % (name, st["what"], len(done), len(BEDS)))
 
 
 if __name__ == "__main__":

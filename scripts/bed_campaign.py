@@ -103,14 +103,17 @@ def beds():
     # Graded 30 cm beds (config/beds/mascot_bed_graded.yaml; docs/scenes.md E.1): the same region,
     # fraction and seeds as the shipped 30 cm beds, the grading's heights mapped by the pile's
     # compaction (its height over the region's).
-    for mat in MATERIALS:
-        for seed in (1, 2, 3):
-            name = "mascot_%s_d30_ga%s" % (mat, "" if seed == 1 else "_s%d" % seed)
-            _, top = fill(MASCOT_R, 0.30, MARGIN["mascot"], mean_volume())
-            ov = ["materials.regolith.preset=%s" % mat, "materials.container.preset=%s" % mat,
-                  "seed=%d" % (2018 + seed - 1), "grains.0.fill.z=[0.0,%.4f]" % top,
-                  "grains.0.fill.grading.compaction=%.4f" % ((0.30 + MARGIN["mascot"]) / top)]
-            out[name] = ("mascot_bed_graded.yaml", ov, "32", None, MASCOT_R, 0.30)
+    # ga: as the file (fine within 0.35 m of the axis and 10 cm below the surface); gd: in depth only
+    # (the published distribution over the whole top 10 cm).
+    for grading, extra in (("ga", []), ("gd", ["grains.0.fill.grading.radial_rate=0"])):
+        for mat in MATERIALS:
+            for seed in (1, 2, 3):
+                name = "mascot_%s_d30_%s%s" % (mat, grading, "" if seed == 1 else "_s%d" % seed)
+                _, top = fill(MASCOT_R, 0.30, MARGIN["mascot"], mean_volume())
+                ov = ["materials.regolith.preset=%s" % mat, "materials.container.preset=%s" % mat,
+                      "seed=%d" % (2018 + seed - 1), "grains.0.fill.z=[0.0,%.4f]" % top,
+                      "grains.0.fill.grading.compaction=%.4f" % ((0.30 + MARGIN["mascot"]) / top)] + extra
+                out[name] = ("mascot_bed_graded.yaml", ov, "32", None, MASCOT_R, 0.30)
     for seed in (1, 2, 3):
         name = "sampler_gravel%s" % ("" if seed == 1 else "_s%d" % seed)
         count, top = fill(SAMPLER_R, 0.20, MARGIN["sampler"], grain_volume(0.0025, 0.30))
@@ -288,12 +291,18 @@ def report(docs):
     print("report: %s" % path)
 
 
+def whole_bed(name):
+    """The whole (ungraded) bed of a graded bed's preparation: mascot_moderate_d30_ga_s2 -> mascot_moderate_d30_s2."""
+    return name.replace("_ga", "").replace("_gd", "")
+
+
 def creep(bin_dir, out, docs, names):
     """Each MASCOT bed in the creep scene (config/validation/bed_creep.yaml): the landing's relaxation,
     then 10 s alone; the surface's height within CREEP_ZONE of the axis before and after the 10 s. A
     graded bed runs at the k_n and dt of the rule on the whole bed of its preparation."""
     known = beds()
-    names = names or [n for n in known if "_d30_ga" in n] + [n.replace("_ga", "") for n in known if "_d30_ga" in n]
+    graded = [n for n in known if "_d30_g" in n]
+    names = names or graded + [whole_bed(n) for n in graded if "_d30_ga" in n]
     campaign_cli.check_names(names, known, "bed")
     for name in names:
         if not name.startswith("mascot_"):
@@ -308,9 +317,8 @@ def creep(bin_dir, out, docs, names):
         mat = name.split("_")[1]
         ov = ["materials.regolith.preset=%s" % mat, "materials.container.preset=%s" % mat,
               "grains.0.file=../beds/%s.bed" % name]
-        if "_ga" in name:
-            kn, dt = rule_contact(os.path.join(ROOT, "config", "beds", name.replace("_ga", "") + ".bed"), 0.19, 0.01, 30,
-                                  2430.0)
+        if whole_bed(name) != name:
+            kn, dt = rule_contact(os.path.join(ROOT, "config", "beds", whole_bed(name) + ".bed"), 0.19, 0.01, 30, 2430.0)
             ov += ["contact.kn=%.10g" % kn, "contact.dt=%.10g" % dt]
         run_dir = os.path.join(out, "creep", name)
         s = campaign_cli.run_and_keep(bin_dir, CREEP, run_dir, keep, ov, {"bed": name}, extra=["--stage-snapshots"])

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Resolution where the lander is (docs/bench/landing.md): paired landings on independent beds.
 
-  bench/landing_savings.py run SETTING [SETTING ...] [--beds NAME,...] [--threads N]
+  bench/landing_savings.py run [SETTING ...] [--beds NAME,...] [--threads N]   (default: every setting)
   bench/landing_savings.py report     docs/bench/landing_report.md, landing_savings.png, savings.csv
   bench/landing_savings.py list       the settings and beds, and which runs are kept
 
@@ -12,7 +12,7 @@ aimed as a perturbed bed (docs/scenes.md A.7): eight paired beds, s1r0 ... s3r1.
 Settings (SETTINGS below): `whole` is the reference, the model with nothing skipped (the whole bed
 free, no sleeping, no free flight, the scene's stiffness and time step); `default` is the shipped
 landing (active zone 0.45 m); the others are savings. A graded setting lands on the graded bed of
-the same preparation (config/beds/mascot_moderate_d30_ga*.bed, docs/scenes.md E.1) with k_n and
+the same preparation (config/beds/mascot_moderate_d30_ga*.bed or _gd*.bed, docs/scenes.md E.1) with k_n and
 Delta-t fixed at the values the k_n rule gives on the whole bed of that preparation (its mean grain
 mass and smallest radius, docs/model.md section 4): the reference's contact law, which the rule
 would otherwise stiffen with the graded bed's larger mean mass. A softer setting changes x_max
@@ -34,7 +34,7 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
 from plots import pyplot, save_figure  # noqa: E402
-from bed_file import rule_contact  # noqa: E402
+from bed_file import mascot_contact  # noqa: E402
 from stats import mean_sd, paired_difference  # noqa: E402
 
 KEEP = os.path.join(ROOT, "results", "bench", "landing")
@@ -46,8 +46,8 @@ MATERIAL = "moderate"
 BEDS = {"s1r0": ("", 0), "s1r1": ("", 1), "s1r2": ("", 2), "s2r0": ("_s2", 0), "s2r1": ("_s2", 1),
         "s2r2": ("_s2", 2), "s3r0": ("_s3", 0), "s3r1": ("_s3", 1)}
 WHOLE = ["landing.active_radius=0"]
-# The scene's contact rule (config/mascot_landing.yaml): v_max, x_max (of the smallest radius), steps per contact.
-V_MAX, X_MAX, STEPS = 0.19, 0.01, 30
+# The scene's x_max (of the smallest radius) and steps per contact (config/mascot_landing.yaml).
+X_MAX, STEPS = 0.01, 30
 # name -> {"grading": bed suffix or "", "sets": [--set ...], "profile": name or None, "x_max", "steps", "what"}
 SETTINGS = {}
 
@@ -82,9 +82,9 @@ def bed_file(prep, grading=""):
     return "beds/mascot_%s_d30%s%s.bed" % (MATERIAL, grading, prep)
 
 
-def pinned_contact(prep, x_max, steps, density=2430.0):
+def pinned_contact(prep, x_max, steps):
     """k_n and Delta-t of the rule on the whole (ungraded) bed of this preparation."""
-    return rule_contact(os.path.join(ROOT, "config", bed_file(prep)), V_MAX, x_max, steps, density)
+    return mascot_contact(os.path.join(ROOT, "config", bed_file(prep)), x_max, steps)
 
 
 def command(bin_dir, name, bed, threads):
@@ -242,9 +242,7 @@ def main():
         if s not in SETTINGS:
             raise SystemExit("landing_savings: unknown setting '%s' (known: %s)" % (s, ", ".join(SETTINGS)))
     if a.cmd == "run":
-        if not a.settings:
-            raise SystemExit("landing_savings: name the settings to run")
-        run(a.settings, beds, a.threads)
+        run(a.settings or list(SETTINGS), beds, a.threads)
     elif a.cmd == "report":
         report()
     else:

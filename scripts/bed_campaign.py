@@ -4,7 +4,8 @@
   bed_campaign.py BIN OUT DOCS study [CASE...]   small beds: lattice against random fills, packing
                                                   against the solid fraction of the generation region
   bed_campaign.py BIN OUT DOCS prepare [BED...]  the shipped beds (config/beds/BED.bed), three seeds of
-                                                  the 30 cm MASCOT beds and of the sampler bed
+                                                  the 30 cm MASCOT beds and of the sampler bed, and the
+                                                  graded 30 cm beds (ga, gd)
   bed_campaign.py BIN OUT DOCS creep [BED...]    how far a prepared MASCOT bed's surface moves when left
                                                   alone for a landing's duration (default: the graded beds
                                                   and their whole beds)
@@ -31,7 +32,7 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
 import campaign_cli  # noqa: E402
-from bed_file import rule_contact, surface  # noqa: E402
+from bed_file import mascot_contact, surface  # noqa: E402
 from plots import pyplot  # noqa: E402
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
@@ -318,7 +319,7 @@ def creep(bin_dir, out, docs, names):
         ov = ["materials.regolith.preset=%s" % mat, "materials.container.preset=%s" % mat,
               "grains.0.file=../beds/%s.bed" % name]
         if whole_bed(name) != name:
-            kn, dt = rule_contact(os.path.join(ROOT, "config", "beds", whole_bed(name) + ".bed"), 0.19, 0.01, 30, 2430.0)
+            kn, dt = mascot_contact(os.path.join(ROOT, "config", "beds", whole_bed(name) + ".bed"))
             ov += ["contact.kn=%.10g" % kn, "contact.dt=%.10g" % dt]
         run_dir = os.path.join(out, "creep", name)
         s = campaign_cli.run_and_keep(bin_dir, CREEP, run_dir, keep, ov, {"bed": name}, extra=["--stage-snapshots"])

@@ -28,6 +28,13 @@ def rule_contact(path, v_max, x_max, steps, density):
     return kn, math.pi * math.sqrt(m_p / (2 * kn)) / steps
 
 
+def mascot_contact(path, x_max=0.01, steps=30):
+    """(k_n, dt) of the MASCOT landing's rule (config/mascot_landing.yaml: v_max 0.19 m/s, x_max 0.01 of the
+    smallest radius, 30 steps per contact, grains of 2430 kg/m^3) on the bed of this snapshot, or with
+    another x_max and steps per contact."""
+    return rule_contact(path, 0.19, x_max, steps, 2430.0)
+
+
 def surface(path, radius, cell):
     """Mean over square cells of side `cell` (their centres within `radius` of the axis) of the highest
     grain top in each: the height of a bed's surface where it is sampled."""

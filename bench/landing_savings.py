@@ -72,6 +72,14 @@ for xm, n in ((0.02, 30), (0.03, 20), (0.05, 15)):
         setting("%s_%s" % (g, tag), "graded bed (%s), x_max %g, %d steps per contact" % (g, xm, n), grading="_" + g,
                 sets=WHOLE, x_max=xm, steps=n)
 
+# The operator preview (config/profiles/preview.yaml: x_max 0.1, 15 steps per contact, 1 cm skin) as
+# shipped (with the zone) and on the graded beds with the whole bed free.
+setting("preview", "today's preview profile (active zone, x_max 0.1, 15 steps per contact)", profile="preview",
+        x_max=0.1, steps=15)
+for g in ("ga", "gd"):
+    setting("%s_preview" % g, "graded bed (%s), the preview's contacts (x_max 0.1, 15 steps, 1 cm skin)" % g,
+            grading="_" + g, sets=WHOLE + ["contact.skin=0.01"], x_max=0.1, steps=15)
+
 # output key, label, margin, relative margin?  (B4, docs/bench/b4_landing.md)
 OUTPUTS = [("speed_ratio", "speed ratio", 0.05, False),
            ("max_penetration", "max penetration (m)", 0.01, False),

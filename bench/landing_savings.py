@@ -68,6 +68,8 @@ setting("gd_zone", "graded bed in depth only (gd) and the active zone 0.45 m", g
 for xm, n in ((0.02, 30), (0.03, 20), (0.05, 15)):
     tag = "x%02d_n%d" % (round(xm * 100), n)
     setting(tag, "whole bed, x_max %g, %d steps per contact" % (xm, n), sets=WHOLE, x_max=xm, steps=n)
+    setting("zone_" + tag, "today's default (active zone 0.45 m), x_max %g, %d steps per contact" % (xm, n), x_max=xm,
+            steps=n)
     for g in ("ga", "gd"):
         setting("%s_%s" % (g, tag), "graded bed (%s), x_max %g, %d steps per contact" % (g, xm, n), grading="_" + g,
                 sets=WHOLE, x_max=xm, steps=n)

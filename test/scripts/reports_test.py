@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Every campaign report regenerated from the committed results is the committed report: the bucket,
 inclined-plane, plume, bed and sampler reports (results/<scene>/), each run on a copy of its
-results folder (nothing under docs/ is written), with its plots drawn."""
+results folder (nothing under docs/ is written), with its plots drawn; and the landing-savings
+report (docs/bench/landing_report.md, savings.csv) from results/bench/landing/."""
 import glob
 import os
 import shutil
@@ -47,6 +48,16 @@ class CampaignReports(unittest.TestCase):
         pages = sorted(os.path.basename(p) for p in glob.glob(os.path.join(DOCS, "beds", "*.md")))
         self.assertTrue(pages)
         self.regenerate("bed_campaign.py", "beds", pages)
+
+    def test_landing_savings(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            r = run([os.path.join("bench", "landing_savings.py"), "report", "--docs", tmp])
+            self.assertEqual(r.returncode, 0, r.stderr[-2000:])
+            for p in ("landing_report.md", "savings.csv"):
+                with open(os.path.join(tmp, p)) as a, open(os.path.join(ROOT, "docs", "bench", p)) as b:
+                    self.assertEqual(a.read(), b.read(), "docs/bench/%s differs from what results/bench/landing/ "
+                                     "gives: run bench/landing_savings.py report" % p)
+            self.assertTrue(os.path.exists(os.path.join(tmp, "landing_savings.png")), "no plot drawn")
 
     def test_sampler_runs_and_campaign(self):
         with tempfile.TemporaryDirectory() as tmp:

@@ -28,13 +28,13 @@ import csv
 import json
 import math
 import os
-import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
 from plots import pyplot, save_figure  # noqa: E402
 from bed_file import mascot_contact  # noqa: E402
+from kept_run import run_kept  # noqa: E402
 from stats import mean_sd, paired_difference  # noqa: E402
 
 KEEP = os.path.join(ROOT, "results", "bench", "landing")
@@ -120,20 +120,10 @@ def run(names, beds, threads):
     for name in names:
         for bed in beds:
             keep = os.path.join(KEEP, "%s_%s.json" % (name, bed))
-            if os.path.exists(keep):
+            s, ran = run_kept(command(bin_dir, name, bed, threads), keep, "bench",
+                              {"setting": name, "bed": bed, "threads": threads}, ROOT)
+            if s is None or not ran:
                 continue
-            cmd = command(bin_dir, name, bed, threads)
-            p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
-            out = cmd[cmd.index("--out") + 1]
-            if p.returncode != 0 or not os.path.exists(os.path.join(out, "summary.json")):
-                print("%s %s: exit %d: %s" % (name, bed, p.returncode, p.stderr.strip()[-400:]), flush=True)
-                continue
-            s = json.load(open(os.path.join(out, "summary.json")))
-            s["bench"] = {"setting": name, "bed": bed, "command": " ".join(os.path.relpath(c, ROOT) if c.startswith(ROOT)
-                                                                          else c for c in cmd), "threads": threads}
-            with open(keep + ".tmp", "w") as f:
-                json.dump(s, f, indent=1)
-            os.replace(keep + ".tmp", keep)
             o = s["outcome"]
             print("%s %s: speed ratio %.3f, penetration %.4f m, travel %.2f m, %.0f s" % (
                 name, bed, o["speed_ratio"], o["max_penetration"], o["travel_distance"], s["run"]["wall_seconds"]),

@@ -17,15 +17,15 @@ Each landing's summary is kept as results/bench/landing_timing/ROUND_LABEL.json 
 run again, so a study resumes on any machine once they are committed); the table goes to
 docs/bench/landing_timing.md."""
 import argparse
-import json
 import os
 import statistics
-import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "bench"))
 import landing_savings as ls  # noqa: E402
+sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
+from kept_run import run_kept  # noqa: E402
 
 KEEP = os.path.join(ROOT, "results", "bench", "landing_timing")
 OUT = os.path.join(ROOT, "out", "bench", "landing_timing")
@@ -35,26 +35,17 @@ PAGE = os.path.join(ROOT, "docs", "bench", "landing_timing.md")
 def land(bin_dir, label, cmd, rnd):
     """Runs one landing (cmd: landing_savings's command with its binary replaced) unless kept."""
     keep = os.path.join(KEEP, "r%d_%s.json" % (rnd, label))
-    if os.path.exists(keep):
-        return json.load(open(keep))
-    out = os.path.join(OUT, "r%d_%s" % (rnd, label))
     cmd = [os.path.join(bin_dir, "regolith_sim")] + cmd[1:]
-    cmd[cmd.index("--out") + 1] = out
-    env = dict(os.environ, LD_LIBRARY_PATH=bin_dir)
-    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, env=env)
-    if p.returncode != 0 or not os.path.exists(os.path.join(out, "summary.json")):
-        sys.exit("landing_timing: %s: exit %d: %s" % (" ".join(cmd), p.returncode, p.stderr.strip()[-600:]))
-    s = json.load(open(os.path.join(out, "summary.json")))
-    s["timing"] = {"label": label, "round": rnd, "binary": bin_dir,
-                   "command": " ".join(os.path.relpath(c, ROOT) if c.startswith(ROOT) else c for c in cmd)}
-    os.makedirs(KEEP, exist_ok=True)
-    with open(keep + ".tmp", "w") as f:
-        json.dump(s, f, indent=1)
-    os.replace(keep + ".tmp", keep)
-    o = s["outcome"]
-    print("round %d %s: %.0f s (speed ratio %.3f, penetration %.4f m, travel %.2f m)" % (
-        rnd, label, s["run"]["wall_seconds"], o["speed_ratio"], o["max_penetration"], o["travel_distance"]),
-        flush=True)
+    cmd[cmd.index("--out") + 1] = os.path.join(OUT, "r%d_%s" % (rnd, label))
+    s, ran = run_kept(cmd, keep, "timing", {"label": label, "round": rnd, "binary": bin_dir}, ROOT,
+                      env=dict(os.environ, LD_LIBRARY_PATH=bin_dir))
+    if s is None:
+        sys.exit("landing_timing: round %d, %s: the landing stopped" % (rnd, label))
+    if ran:
+        o = s["outcome"]
+        print("round %d %s: %.0f s (speed ratio %.3f, penetration %.4f m, travel %.2f m)" % (
+            rnd, label, s["run"]["wall_seconds"], o["speed_ratio"], o["max_penetration"], o["travel_distance"]),
+            flush=True)
     return s
 
 

@@ -19,11 +19,11 @@ import argparse
 import csv
 import json
 import os
-import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
+from kept_run import run_kept  # noqa: E402
 from stats import mean_sd, paired_difference  # noqa: E402
 
 KEEP = os.path.join(ROOT, "results", "bench", "sampler_floor")
@@ -49,23 +49,14 @@ def run(names, repeats, threads):
     for r in repeats:
         for name in names:
             keep = os.path.join(KEEP, "%s_r%d.json" % (name, r))
-            if os.path.exists(keep):
+            cmd = [os.path.join(bin_dir, "regolith_sim"), SCENE, "--out", os.path.join(OUT, "%s_r%d" % (name, r)),
+                   "--threads", str(threads), "--quiet", "--set", "sampler.duration=%g" % DURATION,
+                   "--set", "sampler.repeat=%d" % r]
+            for o in SETTINGS[name][1]:
+                cmd += ["--set", o]
+            s, ran = run_kept(cmd, keep, "bench", {"setting": name, "repeat": r, "threads": threads}, ROOT)
+            if s is None or not ran:
                 continue
-            out = os.path.join(OUT, "%s_r%d" % (name, r))
-            cmd = [os.path.join(bin_dir, "regolith_sim"), SCENE, "--out", out, "--threads", str(threads), "--quiet",
-                   "--set", "sampler.duration=%g" % DURATION, "--set", "sampler.repeat=%d" % r]
-            for s in SETTINGS[name][1]:
-                cmd += ["--set", s]
-            p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
-            if p.returncode != 0 or not os.path.exists(os.path.join(out, "summary.json")):
-                print("%s r%d: exit %d: %s" % (name, r, p.returncode, p.stderr.strip()[-400:]), flush=True)
-                continue
-            s = json.load(open(os.path.join(out, "summary.json")))
-            s["bench"] = {"setting": name, "repeat": r, "threads": threads, "command": " ".join(
-                os.path.relpath(c, ROOT) if c.startswith(ROOT) else c for c in cmd)}
-            with open(keep + ".tmp", "w") as f:
-                json.dump(s, f, indent=1)
-            os.replace(keep + ".tmp", keep)
             print("%s r%d: %s, %.0f s" % (name, r, ", ".join("%s %g" % (lab, get(s)) for lab, get, _ in OUTPUTS),
                                           s["run"]["wall_seconds"]), flush=True)
 

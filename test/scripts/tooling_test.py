@@ -15,6 +15,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts", "lib"))
 import campaign_cli  # noqa: E402
 import csv_columns  # noqa: E402
+import kept_run  # noqa: E402
 import stats  # noqa: E402
 
 
@@ -111,6 +112,43 @@ def load_gate():
     from importlib.machinery import SourceFileLoader
     path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts", "gate")
     return SourceFileLoader("gate", path).load_module()
+
+
+class KeptRuns(unittest.TestCase):
+    """A benchmark run's summary is kept once, with its metadata; a run that stops keeps nothing."""
+
+    def fake(self, t, code):
+        # Stands for regolith_sim: writes OUT/summary.json, then exits with `code`.
+        script = os.path.join(t, "fake.py")
+        with open(script, "w") as f:
+            f.write("import json, os, sys\nout = sys.argv[sys.argv.index('--out') + 1]\nos.makedirs(out)\n"
+                    "json.dump({'run': {'steps': 3}}, open(os.path.join(out, 'summary.json'), 'w'))\n"
+                    "sys.exit(%d)\n" % code)
+        return [sys.executable, script, "--out", os.path.join(t, "out")]
+
+    def test_kept_once_with_its_metadata(self):
+        with tempfile.TemporaryDirectory() as t:
+            keep = os.path.join(t, "kept", "a_s1.json")
+            s, ran = kept_run.run_kept(self.fake(t, 0), keep, "bench", {"setting": "a"}, t)
+            self.assertTrue(ran)
+            self.assertEqual(s["run"]["steps"], 3)
+            self.assertEqual(s["bench"]["setting"], "a")
+            self.assertIn("fake.py --out out", s["bench"]["command"])  # paths inside the tree made relative
+            shutil.rmtree(os.path.join(t, "out"))
+            s2, ran2 = kept_run.run_kept(self.fake(t, 0), keep, "bench", {"setting": "b"}, t)
+            self.assertFalse(ran2)
+            self.assertEqual(s2["bench"]["setting"], "a")
+            self.assertFalse(os.path.exists(os.path.join(t, "out")), "a kept run ran again")
+
+    def test_a_run_that_stops_keeps_nothing(self):
+        with tempfile.TemporaryDirectory() as t:
+            keep = os.path.join(t, "kept", "a_s1.json")
+            with contextlib.redirect_stdout(io.StringIO()) as said:
+                s, ran = kept_run.run_kept(self.fake(t, 3), keep, "bench", {}, t)
+            self.assertIsNone(s)
+            self.assertTrue(ran)
+            self.assertIn("exit 3", said.getvalue())
+            self.assertFalse(os.path.exists(keep))
 
 
 class Gate(unittest.TestCase):

@@ -74,6 +74,13 @@ for xm, n in ((0.02, 30), (0.03, 20), (0.05, 15)):
         setting("%s_%s" % (g, tag), "graded bed (%s), x_max %g, %d steps per contact" % (g, xm, n), grading="_" + g,
                 sets=WHOLE, x_max=xm, steps=n)
 
+# Which of the two knobs moves the outputs: the scene's stiffness with 15 steps per contact, and
+# x_max 0.05 with the scene's 30 steps (on ga, where a landing is cheap).
+setting("ga_x01_n15", "graded bed (ga), the scene's x_max 0.01, 15 steps per contact", grading="_ga", sets=WHOLE,
+        x_max=0.01, steps=15)
+setting("ga_x05_n30", "graded bed (ga), x_max 0.05, the scene's 30 steps per contact", grading="_ga", sets=WHOLE,
+        x_max=0.05, steps=30)
+
 # The operator preview (config/profiles/preview.yaml: x_max 0.1, 15 steps per contact, 1 cm skin) as
 # shipped (with the zone) and on the graded beds with the whole bed free.
 setting("preview", "today's preview profile (active zone, x_max 0.1, 15 steps per contact)", profile="preview",

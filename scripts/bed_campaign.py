@@ -339,6 +339,9 @@ def creep(bin_dir, out, docs, names):
     # Every named bed's kept result against the criterion (a bed run before counts as well).
     creeping = failed
     for name in names:
+        if campaign_cli.kept(os.path.join(docs, "creep", name), "BEDS_RERUN") == "failed" and \
+                "%s (the run failed)" % name not in creeping:
+            creeping.append("%s (the run failed)" % name)  # kept from an earlier call
         p = os.path.join(docs, "creep", name, "summary.json")
         c = json.load(open(p)).get("creep") if os.path.exists(p) else None
         if c and abs(c["drift_over_mean_radius"]) > CREEP_LIMIT:

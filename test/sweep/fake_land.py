@@ -66,7 +66,8 @@ with open(os.path.join(out, "surface.csv"), "w") as f:
                 f.write(f"{x},{y},{-0.02 * math.exp(-(x * x + y * y) / 0.005)}\n")
 summary = {
     "scenario": "fake", "status": status,
-    "input": {"attitude": att, "angle_deg": ang, "speed": 0.19, "repeat": rep},
+    "input": {"attitude": att, "angle_deg": ang, "speed": 0.19, "gravity": float(sets.get("landing.g", 2.5e-4)),
+              "repeat": rep},
     "bed": {"grains": 100, "trim_plane": rim, "packing_fraction": 0.6},
     "outcome": {"contact": True, "lifted_off": lift, "t_contact": 0.4, "t_liftoff": 1.2 if lift else 0,
                 "speed_ratio": ratio, "travel_distance": 10 * ratio, "max_penetration": 0.01 + 0.0001 * ang,

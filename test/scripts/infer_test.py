@@ -1,0 +1,199 @@
+#!/usr/bin/python3
+"""regolith_infer (scripts/lib/infer.py, docs/infer.md) on synthetic ensembles: observations drawn
+from one grid point's ensemble rank that point's hypothesis first in at least 9 of 10 draws; an
+observation outside every ensemble is explained by none; interpolation only between neighbours the
+spread allows; bad queries are refused with a message; --run adds the proposed run to its grid's
+records (a stand-in regolith_land)."""
+import json
+import os
+import random
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
+import infer  # noqa: E402
+
+CLI = os.path.join(ROOT, "scripts", "lib", "infer_cli.py")
+FAKE = os.path.join(ROOT, "test", "sweep", "fake_land.py")
+MATERIALS = ("gravel", "moderate")
+ATTITUDES = ("Flat", "BCF", "FCF")
+ANGLES = (0, 15, 30, 45, 60)
+# Run-to-run spreads of the order the campaigns show (speed ratio, outgoing angle, travel, penetration).
+SD = {"speed_ratio": 0.03, "angle_out_deg": 6.0, "travel_distance": 0.8, "max_penetration": 0.006}
+
+
+def truth(mat, att, ang):
+    """Smooth synthetic means over the grid. The speed ratio's offsets between materials and attitudes
+    are of the size the first look at the shipped 30 cm beds shows (results/campaign/first_look: at
+    30 deg on gravel, Flat 0.30, BCF 0.45, FCF 0.18; moderate BCF 0.25)."""
+    g = mat == "gravel"
+    a = ATTITUDES.index(att)
+    return {"speed_ratio": (0.30 if g else 0.15) + {"Flat": 0.0, "BCF": 0.12, "FCF": -0.12}[att] + 0.003 * ang,
+            "angle_out_deg": 40 + 0.6 * ang + (8 if g else 0) - 12 * a,
+            "travel_distance": (8.0 if g else 5.0) + 0.05 * ang + 1.5 * a,
+            "max_penetration": (0.04 if g else 0.065) - 0.008 * a - 0.0002 * ang}
+
+
+def record(folder, mat, att, ang, rep, out):
+    name = f"{mat}_d30_{att}_a{ang:g}_r{rep}"
+    bed = f"$ROOT/config/beds/mascot_{mat}_d30.bed"
+    rec = {"sweep_run": {"name": name, "material": mat, "depth": 0.3, "attitude": att, "angle": ang, "repeat": rep,
+                         "config": "$ROOT/config/mascot_landing.yaml", "bed": bed, "exit_code": 0, "status": "ok",
+                         "overrides": [f"materials.regolith.preset={mat}", f"materials.container.preset={mat}",
+                                       f"materials.lander.preset={mat}", "landing.rim=0.3", f"grains.0.file={bed}",
+                                       f"landing.attitude={att}", f"landing.angle_deg={ang:g}",
+                                       f"landing.repeat={rep}"]},
+           "summary": {"status": "ok", "input": {"attitude": att, "angle_deg": ang, "speed": 0.19,
+                                                 "gravity": 2.5e-4, "repeat": rep},
+                       "outcome": dict(out, spin_out=0.1, collision_duration=8.0)}}
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, name + ".json"), "w") as f:
+        json.dump(rec, f)
+
+
+def synthetic_campaign(root, repeats=3, seed=7):
+    rng = random.Random(seed)
+    folder = os.path.join(root, "d30", "runs")
+    for mat in MATERIALS:
+        for att in ATTITUDES:
+            for ang in ANGLES:
+                mu = truth(mat, att, ang)
+                for rep in range(repeats):
+                    record(folder, mat, att, ang, rep, {k: rng.gauss(mu[k], SD[k]) for k in SD})
+    return root
+
+
+class Infer(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.mkdtemp(prefix="infer_test_")
+        synthetic_campaign(cls.dir)
+        cls.runs, skipped = infer.load_runs([cls.dir])
+        assert not skipped and len(cls.runs) == 2 * 3 * 5 * 3
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.dir)
+
+    def ask(self, observed, known=None, **kw):
+        return infer.infer(infer.parse_query(dict({"observed": observed, "known": known or {}}, **kw)), self.runs)
+
+    def test_draws_rank_their_hypothesis_first(self):
+        # Observations drawn from the ensemble of a grid point (normal, with the mean and SD of its
+        # runs), observed to half that spread, the angle known to +-10 deg around it and the attitude
+        # unknown: that point's hypothesis ranks first, and is consistent, in at least 9 of 10 draws.
+        rng = random.Random(11)
+        for mat, att, ang in (("gravel", "BCF", 30), ("moderate", "Flat", 15), ("moderate", "FCF", 45),
+                              ("gravel", "Flat", 60)):
+            ens = [r["outcome"] for r in self.runs if r["hyp"] == (mat, 30, "", att) and r["angle"] == ang]
+            self.assertEqual(len(ens), 3)
+            stats = {k: infer._mean_sd([o[k] for o in ens]) for k in SD}
+            first = 0
+            for _ in range(10):
+                obs = {k: [rng.gauss(m, sd), 0.5 * sd] for k, (m, sd) in stats.items()}
+                ans = self.ask(obs, {"angle_deg": [ang - 10, ang + 10], "speed": [0.15, 0.23]})
+                top = ans["hypotheses"][0]
+                first += top["label"] == f"{mat} 30 cm, {att}" and top["consistent"]
+            self.assertGreaterEqual(first, 9, (mat, att, ang, first))
+
+    def test_outside_every_ensemble_is_explained_by_none(self):
+        ans = self.ask({"speed_ratio": [0.95, 0.02], "travel_distance": [30, 2]})
+        self.assertTrue(ans["explained_by_none"])
+        self.assertEqual(ans["explained_by"], [])
+        self.assertTrue(all(not e["consistent"] for e in ans["hypotheses"]))
+        self.assertIn("explained by none", infer.text_report(ans))
+
+    def test_known_ranges_select_the_points(self):
+        ans = self.ask({"speed_ratio": [0.3, 0.05]}, {"attitude": "BCF", "material": ["gravel"],
+                                                     "angle_deg": [20, 40]})
+        self.assertEqual([e["label"] for e in ans["hypotheses"]], ["gravel 30 cm, BCF"])
+        self.assertTrue(all(20 <= p["angle"] <= 40 for p in ans["hypotheses"][0]["points"]))
+        # A speed no ensemble ran at: nothing covers it, and the answer says so.
+        ans = self.ask({"speed_ratio": [0.3, 0.05]}, {"speed": [0.5, 0.6]})
+        self.assertTrue(all(not e["covered"] for e in ans["hypotheses"]))
+        self.assertTrue(ans["explained_by_none"])
+        self.assertTrue(any("no ensemble covers" in n for n in ans["notes"]))
+
+    def test_interpolation_only_where_the_spread_allows(self):
+        # Repeats at mean - sd, mean, mean + sd: every point's mean is its given one and the pooled spread
+        # is sd (0.02). A speed ratio that changes by 0.015 per 15 deg is interpolated between every
+        # pair of grid angles; one that jumps by 0.4 between 30 and 45 deg is not interpolated there.
+        def grid(name, mean):
+            folder = os.path.join(self.dir, name, "runs")
+            for ang in ANGLES:
+                for rep, k in enumerate((-1, 0, 1)):
+                    record(folder, "moderate", "BCF", ang, rep, {"speed_ratio": mean(ang) + 0.02 * k,
+                                                                 "angle_out_deg": 50, "travel_distance": 5,
+                                                                 "max_penetration": 0.05})
+            return infer.load_runs([os.path.join(self.dir, name)])[0]
+
+        q = infer.parse_query({"observed": {"speed_ratio": [0.4, 0.05]}})
+        e = infer.infer(q, grid("smooth", lambda a: 0.2 + 0.001 * a))["hypotheses"][0]
+        self.assertEqual(e["not_interpolated"], [])
+        self.assertEqual(sorted(p["angle"] for p in e["points"] if p["interpolated"]),
+                         [5, 10, 20, 25, 35, 40, 50, 55])
+        p20 = next(p for p in e["points"] if p["angle"] == 20)
+        self.assertAlmostEqual(p20["mean"]["speed_ratio"], 0.22, places=12)
+        e = infer.infer(q, grid("jump", lambda a: 0.2 if a <= 30 else 0.6))["hypotheses"][0]
+        self.assertEqual(e["not_interpolated"], [[30.0, 45.0]])
+        self.assertFalse(any(p["interpolated"] and 30 < p["angle"] < 45 for p in e["points"]))
+        self.assertFalse(e["consistent"])  # 0.4 lies between the two regimes, in neither
+
+    def test_next_runs_come_from_the_candidates(self):
+        mu = truth("moderate", "BCF", 30)
+        ans = self.ask({"speed_ratio": [mu["speed_ratio"], 0.1]}, {"angle_deg": [30, 30]}, next_runs=4)
+        cands = {e["label"] for e in ans["hypotheses"] if e["consistent"] and e["posterior"] >= 0.05}
+        self.assertGreaterEqual(len(cands), 2)
+        self.assertEqual(len(ans["next_runs"]), 4)
+        self.assertTrue(all(r["hypothesis"] in cands and r["angle"] == 30 for r in ans["next_runs"]))
+
+    def test_bad_queries_are_refused(self):
+        for doc, words in (({"observed": {"bounce": [0.3, 0.1]}}, "unknown output"),
+                           ({"observed": {"speed_ratio": [0.3, 0]}}, "sigma must be > 0"),
+                           ({"observed": {"speed_ratio": [0.3, "x"]}}, "expected a number"),
+                           ({"observed": {"speed_ratio": [0.3, 0.1]}, "known": {"angle_deg": [60, 0]}}, "empty"),
+                           ({"observed": {"speed_ratio": [0.3, 0.1]}, "known": {"colour": 1}}, "unknown key"),
+                           ({"observed": {}}, "at least one output"),
+                           ({"observed": {"speed_ratio": [0.3, 0.1]}, "alpha": 2}, "alpha"),
+                           ({"observed": {"speed_ratio": [0.3, 0.1]}, "next_runs": -1}, "next_runs")):
+            with self.assertRaises(infer.InferError) as c:
+                infer.parse_query(doc)
+            self.assertIn(words, str(c.exception))
+
+    def test_cli_answers_and_runs_the_next_run(self):
+        camp = tempfile.mkdtemp(prefix="infer_cli_", dir=self.dir)
+        for mat, att in (("gravel", "BCF"), ("moderate", "BCF")):
+            for rep in range(2):
+                record(os.path.join(camp, "g", "runs"), mat, att, 30, rep, truth(mat, att, 30))
+        out = os.path.join(camp, "answer")
+        base = [sys.executable, CLI, "--campaigns", camp, "--out", out, "--observe", "speed_ratio=0.45+-0.3",
+                "--known", "angle_deg=30"]
+        p = subprocess.run(base + ["--next", "1"], capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        with open(os.path.join(out, "answer.json")) as f:
+            ans = json.load(f)
+        self.assertEqual(len(ans["next_runs"]), 1)
+        self.assertTrue(os.path.getsize(os.path.join(out, "answer.png")) > 1000)
+        # --run 1 with a stand-in regolith_land: the proposed point's next repeat is run and recorded.
+        fake_bin = os.path.join(camp, "bin")
+        os.makedirs(fake_bin)
+        os.symlink(FAKE, os.path.join(fake_bin, "regolith_land"))
+        p = subprocess.run(base + ["--run", "1", "--bin", fake_bin], capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        nxt = ans["next_runs"][0]
+        self.assertTrue(os.path.exists(os.path.join(camp, "g", "runs", f"{nxt['material']}_d30_BCF_a30_r2.json")))
+        with open(os.path.join(out, "answer.json")) as f:
+            self.assertEqual(json.load(f)["runs_used"], 5)
+        p = subprocess.run([sys.executable, CLI, "--campaigns", camp, "--observe", "speed_ratio=0.3+-0"],
+                           capture_output=True, text=True)
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("sigma must be > 0", p.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -79,8 +79,17 @@ def run_name(mat, depth, att, angle, rep):
     return f"{mat}_d{depth_cm(depth)}_{att}_a{fmt_num(angle)}_r{rep}"
 
 
-def bed_file(bed_dir, mat, depth):
-    return os.path.join(bed_dir, f"mascot_{mat}_d{depth_cm(depth)}.bed")
+def bed_file(bed_dir, mat, depth, prep=1):
+    """The bed snapshot of a material and depth; prep > 1: its independent preparation number prep
+    (mascot_<material>_d<cm>_s<prep>.bed, another seed: docs/validation/beds.md)."""
+    return os.path.join(bed_dir, f"mascot_{mat}_d{depth_cm(depth)}{'' if prep == 1 else f'_s{prep}'}.bed")
+
+
+def point_bed(a, point):
+    """(bed, perturbation) of a grid point: with --preparations K, repeat r lands on preparation
+    r mod K + 1, perturbed r div K times over (repeat 0 of each preparation is the bed as prepared)."""
+    rep = point[4]
+    return bed_file(a.bed_dir, point[0], point[1], rep % a.preparations + 1), rep // a.preparations
 
 
 def fill_count(depth):
@@ -299,7 +308,8 @@ def on_signal(signum, _frame):
 
 def run_overrides(a, point, bed):
     """The --set options of one run: the grid point, then the sweep's own --set."""
-    mat, depth, att, angle, rep = point
+    mat, depth, att, angle, _rep = point
+    rep = point_bed(a, point)[1]
     ov = [f"materials.regolith.preset={mat}"]
     # The container and the lander take the friction of the grains (docs/scenes.md A).
     if not a.regolith_only:
@@ -373,7 +383,7 @@ def other_settings(a, p, d):
     meta = read_json(os.path.join(d, "sweep_run.json"))
     if not is_done(d) or meta is None:
         return ""
-    want = run_overrides(a, p, bed_file(a.bed_dir, p[0], p[1]))
+    want = run_overrides(a, p, point_bed(a, p)[0])
     had = meta.get("overrides")
     if meta.get("config") == a.config and had == want:
         return ""
@@ -411,6 +421,7 @@ def sweep(a, grid, land):
     # The grid of this command, for the report.
     write_json(os.path.join(a.out, "sweep.json"),
                dict(a.grid_lists, config=a.config, bed_dir=a.bed_dir, set=a.set, threads=a.threads,
+                    preparations=a.preparations,
                     started=time.strftime("%Y-%m-%d %H:%M:%S")))
     done_before = total - len(todo)
     print(f"sweep: {total} runs in {a.out}/runs ({done_before} already done, {len(todo)} to run)", flush=True)
@@ -425,7 +436,7 @@ def sweep(a, grid, land):
 
     def start(k):
         i, p = todo[k]
-        return pool.submit(run_one, a, land, p, bed_file(a.bed_dir, p[0], p[1]), out_runs, i, total,
+        return pool.submit(run_one, a, land, p, point_bed(a, p)[0], out_runs, i, total,
                            eta_of(len(todo) - k))
 
     pool = concurrent.futures.ThreadPoolExecutor(max_workers=jobs)
@@ -454,6 +465,40 @@ def sweep(a, grid, land):
         raise
     pool.shutdown(wait=True)
     return failed
+
+
+def run_threads(meta):
+    """Threads a finished run used: its command's --threads, else every core of this machine."""
+    cmd = meta.get("command") if isinstance(meta.get("command"), list) else []
+    for i, x in enumerate(cmd[:-1]):
+        if x == "--threads":
+            try:
+                return max(1, int(cmd[i + 1]))
+            except ValueError:
+                break
+    return os.cpu_count() or 1
+
+
+def grid_state(a, grid):
+    """One line on the grid of this command: runs done and left, core-hours spent on the done ones
+    (wall time x threads, as recorded) and the projection for the rest at their mean."""
+    done, core_s = 0, 0.0
+    for p in grid:
+        d = os.path.join(a.out, "runs", run_name(*p))
+        if not is_done(d):
+            continue
+        done += 1
+        meta = read_json(os.path.join(d, "sweep_run.json")) or {}
+        w = meta.get("wall_seconds")
+        if isinstance(w, (int, float)) and not isinstance(w, bool) and w > 0:
+            core_s += w * run_threads(meta)
+    left = len(grid) - done
+    text = f"{done} of {len(grid)} runs done, {left} left; {core_s / 3600:.1f} core-hours spent"
+    if left and done and core_s > 0:
+        rest = left * core_s / done / 3600
+        cores = os.cpu_count() or 1
+        text += f"; the rest about {rest:.1f} core-hours ({rest / cores:.1f} h on {cores} cores)"
+    return text
 
 
 # ---------------------------------------------------------------- Slurm
@@ -517,7 +562,7 @@ def slurm_task(a, grid, land):
     p = grid[k]
     out_runs = os.path.join(a.out, "runs")
     os.makedirs(out_runs, exist_ok=True)
-    rc, status, wall, summary = run_one(a, land, p, bed_file(a.bed_dir, p[0], p[1]), out_runs, k + 1, len(grid),
+    rc, status, wall, summary = run_one(a, land, p, point_bed(a, p)[0], out_runs, k + 1, len(grid),
                                         "(Slurm)")
     report_run(k + 1, len(grid), p, rc, status, wall, summary, "(Slurm)", out_runs, [])
     return 0 if status == "ok" else 1
@@ -708,8 +753,13 @@ def write_report(out, rows, outcome_keys, plots, spread, grid_meta):
         if grid_meta.get("threads"):
             L.append(f"- threads per run: {grid_meta['threads']}")
     L.append("")
-    L.append("Repeat 0 is the bed as prepared; repeats 1, 2, ... are perturbed beds (rotated about the "
-             "container axis, aim point shifted within one grain diameter). A run without lift-off counts "
+    preps = (grid_meta or {}).get("preparations", 1)
+    L.append(("Repeat 0 is the bed as prepared; repeats 1, 2, ... are perturbed beds (rotated about the "
+              "container axis, aim point shifted within one grain diameter). " if preps == 1 else
+              f"Repeats 0 to {preps - 1} land on {preps} independent preparations of each bed (other seeds, "
+              f"each as prepared); repeat r >= {preps} on preparation r mod {preps} + 1, perturbed (rotated "
+              "about the container axis, aim point shifted within one grain diameter). ") +
+             "A run without lift-off counts "
              "with V_out = 0 (speed ratio and travel distance 0); its collision duration is the time until the "
              "run ended (end 'trapped': the lander's kinetic energy stayed below half of what a lift-off needs; "
              "'max_after_contact': the 60 s limit).")
@@ -824,6 +874,9 @@ def make_parser():
     ap.add_argument("--repeats", type=int, default=1,
                     help="beds per grid point: repeat 0 = as prepared, 1.. perturbed (default 1)")
     ap.add_argument("--out", required=True, help="output folder")
+    ap.add_argument("--preparations", type=int, default=1, metavar="K",
+                    help="independent bed preparations (default 1): repeat r lands on preparation r mod K + 1 "
+                         "(mascot_<material>_d<cm>_s<k>.bed for k > 1), perturbed r div K times over")
     ap.add_argument("--config", default=os.path.join(ROOT, "config", "mascot_landing.yaml"),
                     help="landing file (default config/mascot_landing.yaml)")
     ap.add_argument("--bed-dir", default=os.path.join(ROOT, "config", "beds"),
@@ -896,6 +949,8 @@ def main(argv=None):
             fail(f"--angles: {ang} deg is out of range [0, 90) deg from the vertical")
     if not 1 <= a.repeats <= MAX_REPEATS:
         fail(f"--repeats {a.repeats}: expected 1 to {MAX_REPEATS}")
+    if not 1 <= a.preparations <= MAX_REPEATS:
+        fail(f"--preparations {a.preparations}: expected 1 to {MAX_REPEATS}")
     if not 0 <= a.threads <= 256:
         fail(f"--threads {a.threads}: expected 1 to 256 (0: regolith_land's default)")
     if not 1 <= a.jobs <= 256:
@@ -924,19 +979,22 @@ def main(argv=None):
     if a.dry_run:
         for i, p in enumerate(grid, 1):
             d = os.path.join(a.out, "runs", run_name(*p))
-            bed = "" if os.path.isfile(bed_file(a.bed_dir, p[0], p[1])) else " (bed missing)"
+            bed = "" if os.path.isfile(point_bed(a, p)[0]) else " (bed missing)"
             state = "to run"
             if is_done(d):
                 state = "done, with other settings: the sweep refuses it (use another --out, or remove the " \
                         "folder)" if other_settings(a, p, d) else "done"
             print(f"[{i}/{len(grid)}] {run_name(*p)}: {state}{bed}")
-    missing = [(m, d) for m in mats for d in depths if not os.path.isfile(bed_file(a.bed_dir, m, d))]
+    preps = range(1, min(a.preparations, a.repeats) + 1)
+    missing = [(m, d, k) for m in mats for d in depths for k in preps
+               if not os.path.isfile(bed_file(a.bed_dir, m, d, k))]
     if missing:
         msg = ["bed snapshot(s) missing; prepare each once (hours on 2 cores) with:"]
-        for m, d in missing:
-            path = bed_file(a.bed_dir, m, d)
+        for m, d, k in missing:
+            path = bed_file(a.bed_dir, m, d, k)
             msg.append(f"  {path}:")
-            msg.append(f"    {bed_command(sim, m, d, path)}")
+            msg.append(f"    {bed_command(sim, m, d, path)}" if k == 1 else
+                       f"    scripts/validate_beds prepare {os.path.basename(path)[:-4]}  (another seed of the bed)")
         msg.append("(config/beds/mascot_bed.yaml; stages.1 is the trim stage, grains.0.fill.count the grains "
                    "generated: enough that the settled bed reaches the depth)")
         if not a.dry_run:
@@ -958,9 +1016,11 @@ def main(argv=None):
         failed = sweep(a, grid, land)
     except KeyboardInterrupt:
         print("sweep: stopped; the same command continues where it stopped", file=sys.stderr)
+        print(f"sweep: {grid_state(a, grid)}", file=sys.stderr)
         return 130
     print(f"sweep: finished in {fmt_time(time.time() - t0)}"
           + (f"; {len(failed)} failed: {', '.join(failed)}" if failed else ""), flush=True)
+    print(f"sweep: {grid_state(a, grid)}", flush=True)
     report(a)
     return 1 if failed else 0
 

@@ -145,6 +145,30 @@ class SweepTest(unittest.TestCase):
                                first["summary"]["outcome"]["speed_ratio"], places=12)
         self.assertEqual(len(os.listdir(rec)), 24)
 
+    def test_independent_preparations(self):
+        # --preparations 3: repeats 0, 1, 2 land on the bed and its seeds 2 and 3, each as prepared;
+        # repeat 3 on the bed again, perturbed once. A missing seed stops the sweep naming it.
+        cmd = [sys.executable, SWEEP, "--land", FAKE, "--bed-dir", self.beds, "--out", self.out, "--angles", "30",
+               "--repeats", "4", "--preparations", "3", "--no-run-plots"]
+        p = subprocess.run(cmd, capture_output=True, text=True)
+        self.assertEqual(p.returncode, 2, p.stdout + p.stderr)
+        self.assertIn("mascot_moderate_d30_s2.bed", p.stderr)
+        self.assertIn("validate_beds prepare mascot_moderate_d30_s3", p.stderr)
+        for k in (2, 3):
+            open(os.path.join(self.beds, f"mascot_moderate_d30_s{k}.bed"), "w").close()
+        p = subprocess.run(cmd, capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        want = {0: ("mascot_moderate_d30.bed", 0), 1: ("mascot_moderate_d30_s2.bed", 0),
+                2: ("mascot_moderate_d30_s3.bed", 0), 3: ("mascot_moderate_d30.bed", 1)}
+        for r, (bed, perturbation) in want.items():
+            with open(os.path.join(self.out, "runs", f"moderate_d30_BCF_a30_r{r}", "sweep_run.json")) as f:
+                ov = json.load(f)["overrides"]
+            self.assertIn(f"grains.0.file={os.path.join(self.beds, bed)}", ov)
+            self.assertIn(f"landing.repeat={perturbation}", ov)
+        with open(os.path.join(self.out, "report.md")) as f:
+            self.assertIn("3 independent preparations", f.read())
+        self.assertRegex(p.stdout, r"sweep: 4 of 4 runs done, 0 left; [0-9.]+ core-hours spent")
+
     def test_records_of_the_wrong_shape(self):
         # Files of a record's or a run's name that do not hold one (a list, a
         # summary that is a number, a grid point of the wrong types) are named

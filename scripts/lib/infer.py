@@ -46,6 +46,7 @@ KNOWN_KEYS = ("speed", "angle_deg", "attitude", "gravity", "material", "depth")
 # --set keys a sweep always writes for a grid point; the others make the scene variant.
 _POINT_KEYS = re.compile(r"^(materials\.(regolith|container|lander)\.preset|landing\.rim|grains\.0\.file|"
                          r"landing\.attitude|landing\.angle_deg|landing\.repeat|landing\.g|landing\.speed)=")
+DEFAULT_SCENE = "mascot_landing.yaml"  # a record of another scene file is a variant named after it
 GRID_ANGLES = (0.0, 15.0, 30.0, 45.0, 60.0)  # the published campaign's impact angles: proposed where not run
 INTERP_STEP = 5.0   # deg between interpolated angles
 INTERP_SPREADS = 2  # neighbours whose means differ by less than this many pooled spreads are interpolated
@@ -159,12 +160,17 @@ def load_runs(dirs):
                 continue
             inp, out = s["input"], s["outcome"]
             variant = tuple(sorted(o for o in meta.get("overrides", []) if not _POINT_KEYS.match(o)))
+            scene = os.path.basename(str(meta.get("config") or DEFAULT_SCENE))
+            if scene != DEFAULT_SCENE:  # another scene file: the boulder, the cliff
+                variant = (scene[:-5] if scene.endswith(".yaml") else scene,) + variant
             hyp = (str(meta["material"]), int(round(100 * float(meta["depth"]))), "; ".join(variant),
                    str(meta["attitude"]))
             run = {"file": os.path.relpath(f, ROOT) if f.startswith(ROOT) else f, "name": meta.get("name"),
                    "grid": os.path.basename(os.path.dirname(os.path.dirname(f))), "hyp": hyp,
                    "angle": float(meta["angle"]), "speed": float(inp["speed"]), "gravity": float(inp["gravity"]),
                    "repeat": int(meta["repeat"]), "bed": meta.get("bed"), "overrides": meta.get("overrides", []),
+                   "config": meta.get("config") or os.path.join("$ROOT", "config", DEFAULT_SCENE),
+                   "preparations": int(meta.get("preparations", 1)),
                    "outcome": {k: (float(out[src]) * 1.0 if isinstance(out.get(src), (int, float)) else None)
                                for k, (src, *_r) in OUTPUTS.items()}}
         except (OSError, ValueError, KeyError, TypeError) as e:
@@ -176,6 +182,11 @@ def load_runs(dirs):
         seen.add(key)
         runs.append(run)
     return runs, skipped
+
+
+def from_portable(x):
+    """A recorded path or override with the repository written as $ROOT, made absolute here."""
+    return x.replace("$ROOT/", ROOT + os.sep) if isinstance(x, str) else x
 
 
 def hyp_label(h):

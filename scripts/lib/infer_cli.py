@@ -76,13 +76,17 @@ def run_next(a, nxt, runs):
     rep = max(here or same, key=lambda r: sum(1 for x in here if x["file"].rsplit("/", 1)[0] ==
                                               r["file"].rsplit("/", 1)[0]))
     record = os.path.join(ROOT, os.path.dirname(rep["file"]))
-    extra = [o for o in rep["overrides"] if not _SWEEP_POINT.match(o)]
+    extra = [infer.from_portable(o) for o in rep["overrides"] if not _SWEEP_POINT.match(o)]
+    # The grid's bed preparations (sweep --preparations): repeat r lands where the grid's repeat r did.
+    grid_dir = os.path.dirname(rep["file"])
+    preps = max(r["preparations"] for r in runs if os.path.dirname(r["file"]) == grid_dir)
     repeats = 2 + max([r["repeat"] for r in here], default=-1)  # repeats 0 .. the next one
     cmd = [sys.executable, os.path.join(HERE, "sweep.py"), "--land", os.path.join(a.bin, "regolith_land"),
+           "--config", infer.from_portable(rep["config"]),
            "--sim", os.path.join(a.bin, "regolith_sim"), "--materials", nxt["material"], "--depths",
            f"{nxt['depth']:g}", "--attitudes", nxt["attitude"], "--angles", f"{nxt['angle']:g}", "--repeats",
            str(repeats), "--out", os.path.join(a.out, "runs", rep["grid"]), "--record", record, "--jobs", "1",
-           "--spread", "sd", "--no-run-plots"]
+           "--spread", "sd", "--no-run-plots", "--preparations", str(preps)]
     if a.threads:
         cmd += ["--threads", str(a.threads)]
     for o in extra:

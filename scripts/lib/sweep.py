@@ -336,7 +336,7 @@ def run_one(a, land, point, bed, out_runs, index, total, eta_text):
     if a.cache:
         cmd += ["--cache", a.cache]
     meta = {"name": name, "material": mat, "depth": depth, "attitude": att, "angle": angle, "repeat": rep,
-            "config": a.config, "bed": bed, "overrides": overrides, "command": cmd}
+            "preparations": a.preparations, "config": a.config, "bed": bed, "overrides": overrides, "command": cmd}
     print(f"[{index}/{total}] start {name}  ({time.strftime('%H:%M:%S')}; ETA {eta_text})", flush=True)
     t0 = time.time()
     with open(os.path.join(tmp, "run.log"), "w") as log:

@@ -152,6 +152,36 @@ class Infer(unittest.TestCase):
         self.assertEqual(len(ans["next_runs"]), 4)
         self.assertTrue(all(r["hypothesis"] in cands and r["angle"] == 30 for r in ans["next_runs"]))
 
+    def test_scene_variants_are_hypotheses_of_their_own(self):
+        # Runs of another scene file (a boulder under the aim point) and with a setting beyond the grid
+        # point are hypotheses apart from the plain bed's.
+        camp = tempfile.mkdtemp(prefix="infer_variants_", dir=self.dir)
+        mu = truth("moderate", "BCF", 30)
+        record(os.path.join(camp, "plain", "runs"), "moderate", "BCF", 30, 0, mu)
+        for grid, config, extra in (("boulder", "$ROOT/config/mascot_boulder.yaml", ["bodies.1.position=[0,0,0.15]"]),
+                                    ("low_g", "$ROOT/config/mascot_landing.yaml", ["landing.g=1.2e-4"])):
+            folder = os.path.join(camp, grid, "runs")
+            record(folder, "moderate", "BCF", 30, 0, mu)
+            path = os.path.join(folder, "moderate_d30_BCF_a30_r0.json")
+            with open(path) as f:
+                rec = json.load(f)
+            rec["sweep_run"]["config"] = config
+            rec["sweep_run"]["overrides"] += extra
+            if grid == "low_g":
+                rec["summary"]["input"]["gravity"] = 1.2e-4
+            with open(path, "w") as f:
+                json.dump(rec, f)
+        runs, _ = infer.load_runs([camp])
+        labels = sorted(infer.hyp_label(r["hyp"]) for r in runs)
+        self.assertEqual(labels, ["moderate 30 cm [mascot_boulder; bodies.1.position=[0,0,0.15]], BCF",
+                                  "moderate 30 cm, BCF", "moderate 30 cm, BCF"])
+        # The gravity is a condition of the point (landing.g), not a variant: selected by known.gravity.
+        ans = infer.infer(infer.parse_query({"observed": {"speed_ratio": [mu["speed_ratio"], 0.05]},
+                                             "known": {"gravity": 1.2e-4}}), runs)
+        covered = [e for e in ans["hypotheses"] if e["covered"]]
+        self.assertEqual([e["label"] for e in covered], ["moderate 30 cm, BCF"])
+        self.assertEqual([p["gravity"] for p in covered[0]["points"]], [1.2e-4])
+
     def test_bad_queries_are_refused(self):
         for doc, words in (({"observed": {"bounce": [0.3, 0.1]}}, "unknown output"),
                            ({"observed": {"speed_ratio": [0.3, 0]}}, "sigma must be > 0"),

@@ -662,6 +662,33 @@ def groups(rows):
     return g
 
 
+def published_averages(g):
+    """Report lines: the grid points' means averaged as the published tables average them: per angle
+    over materials, attitudes and depths, and per material and angle over attitudes (mean ± s.d. of
+    the point means; n = points)."""
+    def table(title, key_of, head):
+        by = {}
+        for k, rs in g.items():
+            by.setdefault(key_of(k), []).append(k)
+        L = ["", f"## {title}", "", "mean ± s.d. over the grid points' means (n = points).", "",
+             f"| {head} | n | " + " | ".join(label for _, label, _ in PLOTTED) + " |",
+             "|" + "---|" * (head.count("|") + 2 + len(PLOTTED))]
+        for key in sorted(by):
+            cells = []
+            for name, _, scale in PLOTTED:
+                means = [stats([r[name] * scale for r in g[k] if r.get(name) is not None]) for k in by[key]]
+                s = stats([m["mean"] for m in means if m])
+                cells.append("" if not s else f"{s['mean']:.3g}" + (f" ± {s['sd']:.2g}" if s["n"] > 1 else ""))
+            label = " | ".join(fmt_num(x) if isinstance(x, float) else str(x) for x in key)
+            L.append(f"| {label} | {len(by[key])} | " + " | ".join(cells) + " |")
+        return L
+    if not g:
+        return []
+    return (table("Per angle, over materials, attitudes and depths (as the published tables)", lambda k: (k[3],),
+                  "angle (deg)") +
+            table("Per material and angle, over attitudes", lambda k: (k[0], k[3]), "material | angle (deg)"))
+
+
 def plot_metrics(out, rows, spread):
     plt = pyplot()
 
@@ -796,6 +823,7 @@ def write_report(out, rows, outcome_keys, plots, spread, grid_meta):
             lifted = sum(1 for r in rs if r.get("lifted_off"))
             L.append(f"| {k[0]} | {k[1]:g} | {k[2]} | {fmt_num(k[3])} | {len(rs)} | {lifted}/{len(rs)} | "
                      + " | ".join(cells) + " |")
+        L += published_averages(g)
     if rows:
         L += ["", "## Runs", "", "Every number of the summaries is in `aggregate.csv`; per-run plots are in "
               "`runs/<run>/*.png`.", "",

@@ -94,11 +94,15 @@ def parse_query(doc):
             raise InferError(f"observed.{k}: sigma must be > 0 (the observation's uncertainty), got {sig:g}")
         observed[k] = (val, sig)
     known = {}
+    if not isinstance(doc.get("known") or {}, dict):
+        raise InferError("'known' must map keys (" + ", ".join(KNOWN_KEYS) + ") to values or ranges")
     for k, v in (doc.get("known") or {}).items():
         if k not in KNOWN_KEYS:
             raise InferError(f"known.{k}: unknown key (known: {', '.join(KNOWN_KEYS)})")
         if k in ("attitude", "material"):
             items = v if isinstance(v, (list, tuple)) else str(v).split(",")
+            if isinstance(v, dict) or any(isinstance(x, (dict, list, tuple)) for x in items):
+                raise InferError(f"known.{k}: expected a name or a list of names")
             known[k] = {str(x).strip() for x in items if str(x).strip()}
             if not known[k]:
                 raise InferError(f"known.{k}: empty list")
@@ -135,8 +139,8 @@ def parse_cli_value(text, what):
 
 # ------------------------------------------------------------------------------------------ ensembles
 
-def _close(a, b):
-    return abs(a - b) <= 1e-9 * max(1.0, abs(a), abs(b))
+def _finite(x):
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
 
 
 def load_runs(dirs):
@@ -171,8 +175,10 @@ def load_runs(dirs):
                    "repeat": int(meta["repeat"]), "bed": meta.get("bed"), "overrides": meta.get("overrides", []),
                    "config": meta.get("config") or os.path.join("$ROOT", "config", DEFAULT_SCENE),
                    "preparations": int(meta.get("preparations", 1)),
-                   "outcome": {k: (float(out[src]) * 1.0 if isinstance(out.get(src), (int, float)) else None)
+                   "outcome": {k: (float(out[src]) if _finite(out.get(src)) else None)
                                for k, (src, *_r) in OUTPUTS.items()}}
+            if not all(_finite(run[k]) for k in ("angle", "speed", "gravity")):
+                raise ValueError("angle, speed and gravity must be finite numbers")
         except (OSError, ValueError, KeyError, TypeError) as e:
             skipped.append((f, f"not a landing record ({e.__class__.__name__}: {e})"))
             continue

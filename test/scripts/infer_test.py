@@ -190,10 +190,45 @@ class Infer(unittest.TestCase):
                            ({"observed": {"speed_ratio": [0.3, 0.1]}, "known": {"colour": 1}}, "unknown key"),
                            ({"observed": {}}, "at least one output"),
                            ({"observed": {"speed_ratio": [0.3, 0.1]}, "alpha": 2}, "alpha"),
-                           ({"observed": {"speed_ratio": [0.3, 0.1]}, "next_runs": -1}, "next_runs")):
+                           ({"observed": {"speed_ratio": [0.3, 0.1]}, "next_runs": -1}, "next_runs"),
+                           ({"observed": {"speed_ratio": [0.3, 0.1]}, "known": 5}, "'known' must map"),
+                           ({"observed": {"speed_ratio": [0.3, 0.1]}, "known": {"attitude": {"a": 1}}},
+                            "a name or a list"),
+                           ({"observed": {"speed_ratio": [0.3, float("nan")]}}, "finite"),
+                           ("observed", "a mapping")):
             with self.assertRaises(infer.InferError) as c:
                 infer.parse_query(doc)
             self.assertIn(words, str(c.exception))
+
+    def test_records_that_are_not_runs_are_skipped(self):
+        # A record that is not a landing's, or whose numbers are not finite, is skipped with the reason;
+        # an outcome that is not a number counts as missing for that output only.
+        camp = tempfile.mkdtemp(prefix="infer_bad_", dir=self.dir)
+        folder = os.path.join(camp, "g", "runs")
+        mu = truth("gravel", "BCF", 30)
+        for rep in range(3):
+            record(folder, "gravel", "BCF", 30, rep, mu)
+        with open(os.path.join(folder, "junk.json"), "w") as f:
+            f.write("[1, 2")
+        path = os.path.join(folder, "gravel_d30_BCF_a30_r1.json")
+        with open(path) as f:
+            rec = json.load(f)
+        rec["summary"]["input"]["speed"] = float("inf")
+        with open(path, "w") as f:
+            json.dump(rec, f)
+        path = os.path.join(folder, "gravel_d30_BCF_a30_r2.json")
+        with open(path) as f:
+            rec = json.load(f)
+        rec["summary"]["outcome"]["travel_distance"] = "far"
+        with open(path, "w") as f:
+            json.dump(rec, f)
+        runs, skipped = infer.load_runs([camp])
+        self.assertEqual(sorted(os.path.basename(f) for f, _ in skipped),
+                         ["gravel_d30_BCF_a30_r1.json", "junk.json"])
+        self.assertEqual(len(runs), 2)
+        ans = infer.infer(infer.parse_query({"observed": {"speed_ratio": [mu["speed_ratio"], 0.05],
+                                                          "travel_distance": [mu["travel_distance"], 1]}}), runs)
+        self.assertEqual(ans["runs_used"], 1)  # the run without a travel distance is left out of this query
 
     def test_cli_answers_and_runs_the_next_run(self):
         camp = tempfile.mkdtemp(prefix="infer_cli_", dir=self.dir)

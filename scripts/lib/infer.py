@@ -53,6 +53,10 @@ INTERP_SPREADS = 2  # neighbours whose means differ by less than this many poole
 SHRINK = 2          # weight (in runs) of the pooled spread in a point's own
 
 
+MAX_VALUE = 1e6     # largest |value| and sigma of an observation or a known value, SI units
+MIN_SIGMA = 1e-9    # smallest observation uncertainty
+
+
 class InferError(Exception):
     """A query that cannot be answered as given (bad value, unknown output): a clear message."""
 
@@ -92,6 +96,9 @@ def parse_query(doc):
         val, sig = _number(v[0], f"observed.{k} value"), _number(v[1], f"observed.{k} sigma")
         if not sig > 0:
             raise InferError(f"observed.{k}: sigma must be > 0 (the observation's uncertainty), got {sig:g}")
+        if not (abs(val) <= MAX_VALUE and MIN_SIGMA <= sig <= MAX_VALUE):
+            raise InferError(f"observed.{k}: [{val:g}, {sig:g}] is outside the values an answer can be computed "
+                             f"for (|value| <= {MAX_VALUE:g}, {MIN_SIGMA:g} <= sigma <= {MAX_VALUE:g}, SI units)")
         observed[k] = (val, sig)
     known = {}
     if not isinstance(doc.get("known") or {}, dict):
@@ -115,6 +122,8 @@ def parse_query(doc):
             lo = hi = _number(v, f"known.{k}")
         if lo > hi:
             raise InferError(f"known.{k}: the range [{lo:g}, {hi:g}] is empty")
+        if max(abs(lo), abs(hi)) > MAX_VALUE:
+            raise InferError(f"known.{k}: [{lo:g}, {hi:g}] is beyond {MAX_VALUE:g} (SI units)")
         known[k] = (lo, hi)
     alpha = _number(doc.get("alpha", 0.01), "alpha")
     if not 0 < alpha < 1:
@@ -256,7 +265,7 @@ def _loglik(point, observed):
     chi2, ll = 0.0, 0.0
     for o, (y, s) in observed.items():
         sd = point["sd"][o]
-        v = sd * sd * (1 + 1.0 / point["n"]) + s * s
+        v = max(sd * sd * (1 + 1.0 / point["n"]) + s * s, 1e-300)
         z2 = (y - point["mean"][o]) ** 2 / v
         chi2 += z2
         ll += -0.5 * (z2 + math.log(2 * math.pi * v))

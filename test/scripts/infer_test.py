@@ -5,6 +5,7 @@ observation outside every ensemble is explained by none; interpolation only betw
 spread allows; bad queries are refused with a message; --run adds the proposed run to its grid's
 records (a stand-in regolith_land)."""
 import json
+import math
 import os
 import random
 import shutil
@@ -199,6 +200,35 @@ class Infer(unittest.TestCase):
             with self.assertRaises(infer.InferError) as c:
                 infer.parse_query(doc)
             self.assertIn(words, str(c.exception))
+
+    def test_hostile_values_get_an_answer_or_a_message(self):
+        # Every key of the query with hostile values: an answer, or InferError with a message; never
+        # another exception.
+        hostile = [None, "", "x" * 10000, -1, 0, 1e308, -1e308, float("nan"), float("inf"), True, [], [1], [1, 2, 3],
+                   {}, {"value": 1}, {"value": 0.3, "sigma": 0.1}, ["a", "b"], [[0.3], [0.1]], "0:60", "BCF,FCF"]
+        keys = [("observed", o) for o in infer.OUTPUTS] + [("known", k) for k in infer.KNOWN_KEYS] + \
+            [(None, "alpha"), (None, "next_runs")]
+        numbers = [0.0, -0.0, 1e-300, -1e-300, 1e-9, 1e6, -1e6, 1e7, 1e308, -1e308, float("nan"), float("inf")]
+        cases = [(sec, key, v) for sec, key in keys for v in hostile] + \
+            [("observed", "speed_ratio", [x, y]) for x in numbers for y in numbers] + \
+            [("known", k, [x, y]) for k in ("speed", "angle_deg", "gravity", "depth") for x in numbers for y in numbers]
+        for section, key, v in cases:
+            doc = {"observed": {"speed_ratio": [0.3, 0.05]}}
+            if section:
+                doc.setdefault(section, {})[key] = v
+            else:
+                doc[key] = v
+            try:
+                ans = infer.infer(infer.parse_query(doc), self.runs)
+            except infer.InferError as e:
+                self.assertTrue(str(e), (section, key, v))
+                continue
+            self.assertIn("hypotheses", ans, (section, key, v))
+            for e in ans["hypotheses"]:
+                if e["covered"]:
+                    self.assertTrue(math.isfinite(e["log_likelihood"]), (section, key, v))
+                    self.assertTrue(0 <= e["posterior"] <= 1, (section, key, v))
+            json.dumps(ans, allow_nan=False)  # the answer is plain JSON: no NaN or infinity
 
     def test_records_that_are_not_runs_are_skipped(self):
         # A record that is not a landing's, or whose numbers are not finite, is skipped with the reason;

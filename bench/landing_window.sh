@@ -14,13 +14,13 @@ rounds=${3:-1}
 threads=${4:-2}
 mkdir -p "$out"
 declare -A SET=(
-  [zone]=""
+  [zone]="--set landing.active_radius=0.45"
   [free]="--set landing.active_radius=0"
   [sleep_default]="--set landing.active_radius=0 --set sleep.enabled=true"
   [sleep_v1]="--set landing.active_radius=0 --set sleep.enabled=true --set sleep.force=1e9 --set sleep.speed=1"
   [sleep_v5]="--set landing.active_radius=0 --set sleep.enabled=true --set sleep.force=1e9 --set sleep.speed=5"
-  [zone_sleep_v1]="--set sleep.enabled=true --set sleep.force=1e9 --set sleep.speed=1"
-  [zone_free_flight]="--set free_flight.enabled=true"
+  [zone_sleep_v1]="--set landing.active_radius=0.45 --set sleep.enabled=true --set sleep.force=1e9 --set sleep.speed=1"
+  [zone_free_flight]="--set landing.active_radius=0.45 --set free_flight.enabled=true"
 )
 names=("${@:5}")
 ((${#names[@]})) || names=(zone free sleep_default sleep_v1 sleep_v5 zone_sleep_v1)

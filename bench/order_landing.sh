@@ -21,7 +21,8 @@ dts=("$@"); [ ${#dts[@]} -gt 0 ] || dts=(6.25e-6 5e-5 2.5e-5 1.25e-5)
 keep=$ROOT/results/bench/order
 work=${ORDER_WORK:-$ROOT/out/order}
 mkdir -p "$keep" "$work"
-common=(--threads "$threads" --quiet --set guards.allow_under_resolved=true --set landing.max_after_contact=0.5)
+common=(--threads "$threads" --quiet --set guards.allow_under_resolved=true --set landing.max_after_contact=0.5
+  --set landing.active_radius=0.45)  # the active zone, as when the study was run
 land() {  # name dt [extra args]
   local name=$1 dt=$2
   shift 2

@@ -158,7 +158,8 @@ def sweep_box(out):
 
 def sweep_mascot(out):
     cfg = os.path.join(ROOT, "config/mascot_landing.yaml")
-    base = [os.path.join(BIN, "regolith_sim"), cfg, "--set", "landing.max_after_contact=0.1"]
+    base = [os.path.join(BIN, "regolith_sim"), cfg, "--set", "landing.max_after_contact=0.1",
+            "--set", "landing.active_radius=0.45"]  # the active zone, as when the sweep's results were kept
     ref = run_case("mascot", "ref", base, out, {"dt_factor": 1, "kn_factor": 1})
     kn0, dt0, bed = ref["kn"], ref["dt"], ref.get("cache")
     fixed = ["--set", "guards.allow_under_resolved=true"] + (["--relaxed-bed", bed] if bed else [])

@@ -442,14 +442,15 @@ def text_report(answer):
         L.append("known: " + ", ".join(f"{k} {v}" for k, v in answer["known"].items()))
     L.append(f"ensembles: {answer['runs_used']} runs")
     L.append("")
-    L.append(f"{'hypothesis':<44} {'posterior':>9} {'best p':>8} {'at angle':>8}  runs  verdict")
+    w = max([len("hypothesis")] + [len(e["label"]) for e in answer["hypotheses"]])
+    L.append(f"{'hypothesis':<{w}} {'posterior':>9} {'best p':>8} {'at angle':>8}  runs  verdict")
     for e in answer["hypotheses"]:
         if not e["covered"]:
-            L.append(f"{e['label']:<44} {'-':>9} {'-':>8} {'-':>8}  {0:>4}  no runs in the known ranges")
+            L.append(f"{e['label']:<{w}} {'-':>9} {'-':>8} {'-':>8}  {0:>4}  no runs in the known ranges")
             continue
         b = e["best_point"]
         ang = f"{b['angle']:g}" + ("*" if b["interpolated"] else "")
-        L.append(f"{e['label']:<44} {e['posterior']:>9.3f} {b['p_value']:>8.3g} {ang:>8}  {len(set(e['runs'])):>4}  "
+        L.append(f"{e['label']:<{w}} {e['posterior']:>9.3f} {b['p_value']:>8.3g} {ang:>8}  {len(set(e['runs'])):>4}  "
                  + ("consistent" if e["consistent"] else "inconsistent"))
     L.append("")
     if answer["explained_by_none"]:

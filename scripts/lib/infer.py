@@ -26,10 +26,15 @@ import math
 import os
 import re
 
+import sys
+
 from scipy.stats import chi2 as chi2_dist
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, HERE)
+from stats import mean_sd  # noqa: E402
+from sweep import from_portable  # noqa: E402,F401  (the records' $ROOT paths; used by infer_cli too)
 
 # Observable outcome -> (key of summary.outcome, label, scale to the plotted unit, plotted unit,
 # spread assumed when no ensemble has repeats).
@@ -41,11 +46,13 @@ OUTPUTS = {
     "collision_duration": ("collision_duration", "collision duration", 1.0, "s", 2.0),
     "max_penetration": ("max_penetration", "maximum penetration", 100.0, "cm", 0.01),
 }
-# What is known of the impact: key -> how a run gives it.
+# What a query may give as known of the impact.
 KNOWN_KEYS = ("speed", "angle_deg", "attitude", "gravity", "material", "depth")
-# --set keys a sweep always writes for a grid point; the others make the scene variant.
-_POINT_KEYS = re.compile(r"^(materials\.(regolith|container|lander)\.preset|landing\.rim|grains\.0\.file|"
-                         r"landing\.attitude|landing\.angle_deg|landing\.repeat|landing\.g|landing\.speed)=")
+# --set keys a sweep writes for each grid point itself (scripts/lib/sweep.py, run_overrides), and the
+# impact conditions a run's summary states; every other override of a record makes the scene variant.
+SWEEP_POINT = re.compile(r"^(materials\.(regolith|container|lander)\.preset|landing\.rim|grains\.0\.file|"
+                         r"landing\.attitude|landing\.angle_deg|landing\.repeat)=")
+_CONDITION = re.compile(r"^landing\.(g|speed)=")
 DEFAULT_SCENE = "mascot_landing.yaml"  # a record of another scene file is a variant named after it
 GRID_ANGLES = (0.0, 15.0, 30.0, 45.0, 60.0)  # the published campaign's impact angles: proposed where not run
 INTERP_STEP = 5.0   # deg between interpolated angles
@@ -134,7 +141,7 @@ def parse_query(doc):
     return {"observed": observed, "known": known, "alpha": alpha, "next_runs": nxt}
 
 
-def parse_cli_value(text, what):
+def parse_cli_value(text):
     """'0.3+-0.05' or '0.3,0.05' -> [0.3, 0.05] (an observation); '0:60' -> [0, 60]; 'BCF,FCF' -> a list."""
     for sep in ("+-", "±"):
         if sep in text:
@@ -172,7 +179,8 @@ def load_runs(dirs):
                 skipped.append((f, "not a finished run"))
                 continue
             inp, out = s["input"], s["outcome"]
-            variant = tuple(sorted(o for o in meta.get("overrides", []) if not _POINT_KEYS.match(o)))
+            variant = tuple(sorted(o for o in meta.get("overrides", [])
+                                   if not SWEEP_POINT.match(o) and not _CONDITION.match(o)))
             scene = os.path.basename(str(meta.get("config") or DEFAULT_SCENE))
             if scene != DEFAULT_SCENE:  # another scene file: the boulder, the cliff
                 variant = (scene[:-5] if scene.endswith(".yaml") else scene,) + variant
@@ -199,20 +207,9 @@ def load_runs(dirs):
     return runs, skipped
 
 
-def from_portable(x):
-    """A recorded path or override with the repository written as $ROOT, made absolute here."""
-    return x.replace("$ROOT/", ROOT + os.sep) if isinstance(x, str) else x
-
-
 def hyp_label(h):
     mat, cm, variant, att = h
     return f"{mat} {cm} cm" + (f" [{variant}]" if variant else "") + f", {att}"
-
-
-def _mean_sd(xs):
-    n = len(xs)
-    m = math.fsum(xs) / n
-    return m, (math.sqrt(math.fsum((x - m) ** 2 for x in xs) / (n - 1)) if n > 1 else None)
 
 
 def pooled_spread(points, outputs):
@@ -224,7 +221,7 @@ def pooled_spread(points, outputs):
         for p in points.values():
             xs = [r["outcome"][o] for r in p["runs"] if r["outcome"][o] is not None]
             if len(xs) > 1:
-                m, sd = _mean_sd(xs)
+                m, sd = mean_sd(xs, missing=None)
                 ss += (len(xs) - 1) * sd * sd
                 dof += len(xs) - 1
         pooled[o] = (math.sqrt(ss / dof), dof) if dof else (OUTPUTS[o][4], 0)
@@ -243,7 +240,7 @@ def group_points(runs, outputs):
         p["n"] = len(p["runs"])
         p["mean"], p["sd"] = {}, {}
         for o in outputs:
-            m, sd = _mean_sd([r["outcome"][o] for r in p["runs"]])
+            m, sd = mean_sd([r["outcome"][o] for r in p["runs"]], missing=None)
             pool = pooled[o][0]
             # The point's own spread, shrunk towards the pooled one (SHRINK runs' worth of it).
             p["mean"][o] = m

@@ -11,7 +11,6 @@ ranking. Exit status: 0 answered (whether or not a hypothesis is consistent), 2 
 import argparse
 import json
 import os
-import re
 import subprocess
 import sys
 
@@ -22,10 +21,6 @@ sys.path.insert(0, HERE)
 import infer  # noqa: E402
 
 ROOT = infer.ROOT
-# The --set keys a sweep writes for each grid point itself; the rest of a record's overrides are
-# passed on to a new run of the same hypothesis.
-_SWEEP_POINT = re.compile(r"^(materials\.(regolith|container|lander)\.preset|landing\.rim|grains\.0\.file|"
-                          r"landing\.attitude|landing\.angle_deg|landing\.repeat)=")
 
 
 def query_from_args(a):
@@ -44,7 +39,7 @@ def query_from_args(a):
                 raise infer.InferError(f"--{'observe' if kind == 'observed' else 'known'} '{item}': expected KEY=VALUE")
             k, v = item.split("=", 1)
             doc.setdefault(kind, {})
-            doc[kind][k.strip()] = infer.parse_cli_value(v, k)
+            doc[kind][k.strip()] = infer.parse_cli_value(v)
     if a.alpha is not None:
         doc["alpha"] = a.alpha
     if a.next is not None:
@@ -76,7 +71,7 @@ def run_next(a, nxt, runs):
     rep = max(here or same, key=lambda r: sum(1 for x in here if x["file"].rsplit("/", 1)[0] ==
                                               r["file"].rsplit("/", 1)[0]))
     record = os.path.join(ROOT, os.path.dirname(rep["file"]))
-    extra = [infer.from_portable(o) for o in rep["overrides"] if not _SWEEP_POINT.match(o)]
+    extra = [infer.from_portable(o) for o in rep["overrides"] if not infer.SWEEP_POINT.match(o)]
     # The grid's bed preparations (sweep --preparations): repeat r lands where the grid's repeat r did.
     grid_dir = os.path.dirname(rep["file"])
     preps = max(r["preparations"] for r in runs if os.path.dirname(r["file"]) == grid_dir)

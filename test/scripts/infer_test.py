@@ -93,7 +93,7 @@ class Infer(unittest.TestCase):
                               ("gravel", "Flat", 60)):
             ens = [r["outcome"] for r in self.runs if r["hyp"] == (mat, 30, "", att) and r["angle"] == ang]
             self.assertEqual(len(ens), 3)
-            stats = {k: infer._mean_sd([o[k] for o in ens]) for k in SD}
+            stats = {k: infer.mean_sd([o[k] for o in ens]) for k in SD}
             first = 0
             for _ in range(10):
                 obs = {k: [rng.gauss(m, sd), 0.5 * sd] for k, (m, sd) in stats.items()}

@@ -37,6 +37,11 @@ from plots import pyplot  # noqa: E402
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 SMALL = os.path.join(ROOT, "config", "validation", "bed_small.yaml")
+# The small bed scaled to the sampler's grains (2.5 mm, sigma 30 %): every length a quarter of the
+# small bed's, the sampler bed's first-stage contacts (config/validation/bed_small_sampler.yaml).
+SMALL_SAMPLER = os.path.join(ROOT, "config", "validation", "bed_small_sampler.yaml")
+SAMPLER_SCALE = 0.25  # sampler mean grain radius over the MASCOT one
+SAMPLER_FRACTIONS = [0.06, 0.15]
 R_SMALL = 0.25        # container radius of the small bed, m
 N_SMALL = 5000        # grains generated
 MEAN_VOLUME = None    # mean grain volume, m^3 (from the radius distribution; computed once)
@@ -170,7 +175,7 @@ def prepare(bin_dir, out, docs, names):
 
 
 def cases():
-    """name -> (material, overrides)."""
+    """name -> (material, overrides, config, length scale of the bed)."""
     out = {}
     for mat in MATERIALS:
         mo = ["materials.regolith.preset=%s" % mat, "materials.container.preset=%s" % mat]
@@ -184,7 +189,16 @@ def cases():
             for seed in SEEDS:
                 out["random_%s_f%.2f_s%d" % (mat, f, seed)] = (
                     mat, mo + ["grains.0.fill.z=[0.0,%.4f]" % top, "seed=%d" % seed])
-    return out
+    # The same pour with the sampler's grains on a bed scaled to them: is the packing set by the
+    # region's height in grain radii (the sampler bed's region is 2.6 times the MASCOT 30 cm bed's
+    # in those units at the same f), whatever the grains' size, stiffness and wall restitution?
+    r_s = R_SMALL * SAMPLER_SCALE
+    for f in SAMPLER_FRACTIONS:
+        top = N_SMALL * grain_volume(0.0025, 0.30) / (math.pi * r_s ** 2 * f)
+        for seed in SEEDS:
+            out["sampler_grains_f%.2f_s%d" % (f, seed)] = (
+                "gravel", ["grains.0.fill.z=[0.0,%.4f]" % top, "seed=%d" % seed], SMALL_SAMPLER, SAMPLER_SCALE)
+    return {k: v if len(v) == 4 else v + (SMALL, 1.0) for k, v in out.items()}
 
 
 def cap_volume(r, h):
@@ -194,23 +208,25 @@ def cap_volume(r, h):
     return math.pi * a * a * (3 * r - a) / 3
 
 
-def packing(grains_file):
-    """Packing figures of a settled small bed from its final_grains.txt."""
+def packing(grains_file, scale=1.0):
+    """Packing figures of a settled small bed from its final_grains.txt (every length of the core region,
+    the trim height and the container multiplied by scale for a bed scaled to other grains)."""
     rows = [list(map(float, ln.split()))[1:5] for ln in open(grains_file) if not ln.startswith("#")]
     tops = sorted(z + r for _, _, z, r in rows)
     top = sum(tops[-50:]) / 50  # the pile's top: the mean top of its 50 highest grains
-    zlo, zhi = CORE_FLOOR, min(H_TRIM, top) - CORE_FLOOR
-    rin = R_SMALL - CORE_WALL
+    h_trim, radius = H_TRIM * scale, R_SMALL * scale
+    zlo, zhi = CORE_FLOOR * scale, min(h_trim, top) - CORE_FLOOR * scale
+    rin = radius - CORE_WALL * scale
     vol = 0.0
     for x, y, z, r in rows:
         if math.hypot(x, y) < rin:
             vol += cap_volume(r, zhi - z) - cap_volume(r, zlo - z)
     core = vol / (math.pi * rin * rin * (zhi - zlo))
-    n_centre = sum(1 for _, _, z, _ in rows if z <= H_TRIM)
-    n_top = sum(1 for _, _, z, r in rows if z + r <= H_TRIM)
+    n_centre = sum(1 for _, _, z, _ in rows if z <= h_trim)
+    n_top = sum(1 for _, _, z, r in rows if z + r <= h_trim)
     return {"core_packing": core, "top": top, "n_centre": n_centre, "n_top": n_top,
-            "packing_centre_trim": sum((4 / 3) * math.pi * r ** 3 for _, _, z, r in rows if z <= H_TRIM)
-            / (math.pi * R_SMALL ** 2 * H_TRIM)}
+            "packing_centre_trim": sum((4 / 3) * math.pi * r ** 3 for _, _, z, r in rows if z <= h_trim)
+            / (math.pi * radius ** 2 * h_trim)}
 
 
 def study(bin_dir, out, docs, names):
@@ -221,17 +237,18 @@ def study(bin_dir, out, docs, names):
         keep = os.path.join(keep_root, name)
         if campaign_cli.kept(keep, "BEDS_RERUN") is not None:
             continue
-        mat, overrides = known[name]
+        mat, overrides, config, scale = known[name]
         run_dir = os.path.join(out, name)
-        s = campaign_cli.run_and_keep(bin_dir, SMALL, run_dir, keep, overrides, {"case": name, "material": mat})
+        s = campaign_cli.run_and_keep(bin_dir, config, run_dir, keep, overrides, {"case": name, "material": mat})
         if s is None:
             continue
-        p = packing(os.path.join(run_dir, "final_grains.txt"))
+        p = packing(os.path.join(run_dir, "final_grains.txt"), scale)
         s["packing"] = p
         with open(os.path.join(keep, "summary.json"), "w") as f:
             json.dump(s, f, indent=1)
         print("%s: core packing %.4f, %d grains below %.2f m by centre, %d by top (%.0f s)" % (
-            name, p["core_packing"], p["n_centre"], H_TRIM, p["n_top"], s["campaign"]["wall_seconds"]), flush=True)
+            name, p["core_packing"], p["n_centre"], H_TRIM * scale, p["n_top"], s["campaign"]["wall_seconds"]),
+            flush=True)
 
 
 def load(docs):
@@ -256,8 +273,14 @@ def report(docs):
              "pile's top or the %.2f m trim height, within %.2f m of the axis (%.2f m from the wall). "
              "**Counts**: grains whose centre, or whose top, is at or below %.2f m. "
              "f: the solid fraction of the random generation region (its height is N ⟨V⟩ / (π R² f)); "
-             "the lattice is the jittered simple cubic fill the beds were generated on before." % (
-                 R_SMALL, CORE_FLOOR, CORE_FLOOR, H_TRIM, R_SMALL - CORE_WALL, CORE_WALL, H_TRIM), "",
+             "the lattice is the jittered simple cubic fill the beds were generated on before. "
+             "`sampler_grains_*`: the same pour with the sampler bed's grains (2.5 mm mean radius, σ 30 %%) "
+             "and first-stage contacts (k_n 1.97e4 N/m, Δt 25 µs, wall restitution 0.3) on a bed scaled "
+             "to them (`config/validation/bed_small_sampler.yaml`: every length, the core region's and "
+             "the trim height's included, %g times the above), so that at one f the region is as tall "
+             "in grain radii as the MASCOT-grain bed's." % (
+                 R_SMALL, CORE_FLOOR, CORE_FLOOR, H_TRIM, R_SMALL - CORE_WALL, CORE_WALL, H_TRIM,
+                 SAMPLER_SCALE), "",
              "| case | material | fill | f | seed | core packing | grains by centre | by top | wall (s) |",
              "|---|---|---|---|---|---|---|---|---|"]
     fig, ax = plt.subplots(1, 1, figsize=(6, 4))
@@ -271,14 +294,20 @@ def report(docs):
             ys.append(s["packing"]["core_packing"])
         if xs:
             ax.plot(xs, ys, "o", color=color, label="%s, random fill" % mat)
+        if mat == "gravel":
+            pts = [(float(n.split("_f")[1].split("_")[0]), s["packing"]["core_packing"])
+                   for n, s in runs.items() if n.startswith("sampler_grains")]
+            if pts:
+                ax.plot([f for f, _ in pts], [c for _, c in pts], "x", color=color, ms=8,
+                        label="gravel, sampler grains (bed scaled by %g)" % SAMPLER_SCALE)
         lat = runs.get("lattice_%s" % mat)
         if lat:
             ax.axhline(lat["packing"]["core_packing"], color=color, ls="--", lw=1, label="%s, lattice fill" % mat)
     for name, s in runs.items():
         p = s["packing"]
-        if name.startswith("random"):
+        if name.startswith("random") or name.startswith("sampler_grains"):
             f, seed = name.split("_f")[1].split("_s")
-            fill = "random"
+            fill = "random" if name.startswith("random") else "random, sampler grains, scaled bed"
         else:
             f, seed = "–", "–"
             fill = "lattice 4 cm, jitter ±6.7 mm" if name.startswith("lattice_wide") else "lattice"

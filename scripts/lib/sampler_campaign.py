@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The sampler campaign (scripts/validate_sampler campaign): 1 s shots at 300
-and 50 m/s on perturbed beds, side by side.
+and 50 m/s on perturbed beds, side by side; and the shots on the shipped beds
+(scripts/validate_sampler shots).
 
 usage: sampler_campaign.py OUT_DIR DOCS_DIR
 
@@ -9,7 +10,10 @@ run was made on this machine) is thinned to DOCS_DIR/<run>/series_thin.csv (at
 most 400 rows, kept with the run's summary); then DOCS_DIR/campaign.md (one
 row per shot, mean and SD per speed) and DOCS_DIR/campaign_*.png (collected
 mass, crater depth and radius, grains in the horn against time; ejection
-angle histograms) are written from DOCS_DIR.
+angle histograms) are written from DOCS_DIR. The same for the shots
+shots/v<speed>[_1s]_b<bed> (to 0.25 s at the scene's stiffness, or 1 s with
+the stiffness schedule, on the shipped bed <bed>): DOCS_DIR/shots/report.md
+and DOCS_DIR/shots/shots_*.png, one table and one set of plots per duration.
 """
 import argparse
 import csv
@@ -23,6 +27,7 @@ from plots import pyplot, save_figure
 from stats import mean_sd
 
 RUN = re.compile(r"^c(\d+)_r(\d+)$")
+SHOT = re.compile(r"^v(\d+)(_1s)?_b(\d+)$")
 
 
 def thin(src, dst, rows_max=400):
@@ -82,15 +87,12 @@ def outcome(s):
     }
 
 
-def main():
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("out", metavar="OUT")
-    p.add_argument("docs", metavar="DOCS")
-    a = p.parse_args()
-    out, docs = a.out, a.docs
+def collect(out, docs, pattern, key):
+    """name -> (speed, bed or repeat, summary, outcome) of the runs in docs whose name matches pattern
+    (key(match) -> (speed, bed or repeat)); each run's series is thinned from out/<name> when it is there."""
     runs = {}
-    for name in sorted(os.listdir(docs)):
-        m = RUN.match(name)
+    for name in sorted(os.listdir(docs)) if os.path.isdir(docs) else []:
+        m = pattern.match(name)
         p = os.path.join(docs, name, "summary.json")
         if not m or not os.path.isfile(p):
             continue
@@ -99,13 +101,17 @@ def main():
             thin(src, os.path.join(docs, name, "series_thin.csv"))
         with open(p) as f:
             s = json.load(f)
-        runs[name] = (int(m.group(1)), int(m.group(2)), s, outcome(s))
-    if not runs:
-        sys.exit(f"sampler_campaign: no campaign runs (c<speed>_r<repeat>/summary.json) in {docs}")
+        runs[name] = key(m) + (s, outcome(s))
+    return runs
 
-    lines = ["| shot | speed m/s | bed repeat | collected at 1 s mg | 100 mg reached at s | grains in horn (cyl. 1-5) | "
-             "crater depth / radius mm | ejected grains (cm³) | ejection angle mean / median deg | Z (H0 = 0) | steps | wall s (threads) |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+
+def write(runs, docs, md, prefix, bed_word, end_word):
+    """md (one row per shot, mean and SD per speed) and prefix_series.png, prefix_ejection_angles.png in docs."""
+    lines = [
+        "| shot | speed m/s | %s | collected %s mg | 100 mg reached at s | grains in horn (cyl. 1-5) | "
+        "crater depth / radius mm | ejected grains (cm³) | ejection angle mean / median deg | Z (H0 = 0) | steps | "
+        "wall s (threads) |" % (bed_word, end_word),
+        "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, (v, rep, s, o) in runs.items():
         lines.append(
             f"| {name} | {v} | {rep} | {o['collected_mg']:.1f} | "
@@ -127,14 +133,14 @@ def main():
             return fmt(*mean_sd([o[key] for o in os_], missing=None), digits=digits)
         lines.append(f"| {v} | {len(os_)} | {col('collected_mg')} | {col('in_horn', 0)} | {col('crater_depth_mm')} | "
                      f"{col('crater_radius_mm')} | {col('ejected', 0)} | {col('angle_mean')} | {col('z', 2)} |")
-    with open(os.path.join(docs, "campaign.md"), "w") as f:
+    with open(os.path.join(docs, md), "w") as f:
         f.write("\n".join(lines) + "\n")
 
     try:
         plt = pyplot()
     except ImportError:
         print("sampler_campaign: matplotlib missing, no plots", file=sys.stderr)
-        return 0
+        return
     colours = {300: "tab:red", 50: "tab:blue"}
     styles = ["-", "--", ":", "-."]
     fig, ax = plt.subplots(2, 2, figsize=(11, 7.5))
@@ -143,7 +149,7 @@ def main():
         if ser is None:
             continue
         t = ser["t"]
-        kw = dict(color=colours.get(v, "k"), ls=styles[rep % len(styles)], label=f"{v} m/s, bed {rep}")
+        kw = dict(color=colours.get(v, "k"), ls=styles[rep % len(styles)], label=f"{v} m/s, {bed_word} {rep}")
         ax[0][0].plot(t, [1e6 * x for x in ser["collected_mass"]], **kw)
         ax[0][1].plot(t, [sum(ser[f"seg{k}_n"][i] for k in range(1, 6)) for i in range(len(t))], **kw)
         ax[1][0].plot(t, [1e3 * x for x in ser["crater_depth"]], **kw)
@@ -154,7 +160,7 @@ def main():
         a.set_xlabel("time after firing (s)")
         a.set_ylabel(lab)
     ax[0][0].legend(fontsize=8)
-    save_figure(fig, os.path.join(docs, "campaign_series.png"))
+    save_figure(fig, os.path.join(docs, prefix + "_series.png"))
     fig, ax = plt.subplots(figsize=(6.5, 4))
     for name, (v, rep, s, o) in runs.items():
         h, b = o["hist"], o["bin_deg"]
@@ -162,11 +168,57 @@ def main():
             continue
         tot = float(sum(h)) or 1.0
         ax.step([b * (i + 0.5) for i in range(len(h))], [x / tot for x in h], where="mid",
-                color=colours.get(v, "k"), ls=styles[rep % len(styles)], label=f"{v} m/s, bed {rep}")
+                color=colours.get(v, "k"), ls=styles[rep % len(styles)], label=f"{v} m/s, {bed_word} {rep}")
     ax.set_xlabel("ejection angle from the horizontal (deg)")
     ax.set_ylabel("fraction of ejected grains")
     ax.legend(fontsize=8)
-    save_figure(fig, os.path.join(docs, "campaign_ejection_angles.png"))
+    save_figure(fig, os.path.join(docs, prefix + "_ejection_angles.png"))
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("out", metavar="OUT")
+    p.add_argument("docs", metavar="DOCS")
+    a = p.parse_args()
+    out, docs = a.out, a.docs
+    runs = collect(out, docs, RUN, lambda m: (int(m.group(1)), int(m.group(2))))
+    sdocs, sout = os.path.join(docs, "shots"), os.path.join(out, "shots")
+    shots = {d: collect(sout, sdocs, SHOT, lambda m: (int(m.group(1)), int(m.group(3))))
+             for d in ("0.25 s", "1 s")}
+    for name in list(shots["0.25 s"]):
+        if SHOT.match(name).group(2):
+            shots["1 s"][name] = shots["0.25 s"].pop(name)
+    for name in list(shots["1 s"]):
+        if not SHOT.match(name).group(2):
+            del shots["1 s"][name]
+    if not runs and not any(shots.values()):
+        sys.exit(f"sampler_campaign: no campaign runs (c<speed>_r<repeat>/summary.json) or shots "
+                 f"(shots/v<speed>[_1s]_b<bed>/summary.json) in {docs}")
+    if runs:
+        write(runs, docs, "campaign.md", "campaign", "bed repeat", "at 1 s")
+    parts = []
+    for d, got in shots.items():
+        if not got:
+            continue
+        tag = "shots_1s" if d == "1 s" else "shots_025s"
+        write(got, sdocs, tag + ".md", tag, "bed", "at %s" % d)
+        parts.append((d, tag))
+    if parts:
+        lines = ["# Sampler shots on the shipped beds", "",
+                 "Generated by `scripts/lib/sampler_campaign.py` (`scripts/validate_sampler shots`) from "
+                 "`shots/*/summary.json`. Bed k: `config/beds/sampler_gravel.bed`, `_s2`, `_s3` (three "
+                 "independent preparations, docs/validation/beds.md)."]
+        for d, tag in parts:
+            with open(os.path.join(sdocs, tag + ".md")) as f:
+                body = f.read()
+            os.remove(os.path.join(sdocs, tag + ".md"))
+            what = ("to 1 s after firing with the stiffness schedule (docs/model.md §17)" if d == "1 s" else
+                    "to 0.25 s after firing at the scene's stiffness")
+            lines += ["", "## Shots %s" % what, "", body.rstrip("\n"), "",
+                      "![%s: against time](%s_series.png)" % (d, tag),
+                      "![%s: ejection angles](%s_ejection_angles.png)" % (d, tag)]
+        with open(os.path.join(sdocs, "report.md"), "w") as f:
+            f.write("\n".join(lines) + "\n")
     return 0
 
 

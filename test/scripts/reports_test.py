@@ -71,6 +71,11 @@ class CampaignReports(unittest.TestCase):
             self.assertEqual(r.returncode, 0, r.stderr[-2000:])
             with open(os.path.join(docs, "campaign.md")) as a, open(os.path.join(DOCS, "sampler", "campaign.md")) as b:
                 self.assertEqual(a.read(), b.read())
+            shots = os.path.join(DOCS, "sampler", "shots", "report.md")
+            if os.path.exists(shots):
+                with open(os.path.join(docs, "shots", "report.md")) as a, open(shots) as b:
+                    self.assertEqual(a.read(), b.read(), "results/sampler/shots/report.md differs from what its "
+                                     "runs give: run scripts/lib/sampler_campaign.py")
 
 
 class Plots(unittest.TestCase):

@@ -1,19 +1,23 @@
 #!/usr/bin/python3
 """The sampler shot's stiffness schedule with a floor, paired against the full-stiffness reference on
-perturbed beds to 0.2 s (docs/bench/b3_schedule.md, "With a floor").
+the three shipped beds, compared at 0.2 s (docs/bench/b3_schedule.md, "With a floor").
 
-  bench/sampler_floor.py run [SETTING ...] [--repeats 0,1,2] [--threads 2]
+  bench/sampler_floor.py run [SETTING ...] [--beds 1,2,3] [--threads 2]
   bench/sampler_floor.py report     docs/bench/sampler_floor.md, sampler_floor.csv
   bench/sampler_floor.py list       the settings and which runs are kept
 
-Settings: `off` is the reference (every saving off: the scene's k_n and time step throughout); `floorF`
-runs the stiffness schedule (docs/model.md section 17) with k_n never below F times the scene's. The beds
-are the shipped sampler bed as prepared (repeat 0) and rotated with the impact point shifted within a
-mean radius (repeats 1, 2, ...; docs/scenes.md B). Outputs at 0.2 s and their margins (B4): the grains in
-horn segments 1 and 2 (15 % each) and the crater depth (5 %); the ejected grains are reported beside.
+Beds: the three independent preparations (config/beds/sampler_gravel.bed, _s2, _s3; bed k). Every shot
+runs to 0.25 s after firing on bed k as prepared and is compared at 0.2 s, read from its series (the row
+nearest 0.2 s). The reference, `off` (every saving off: the scene's k_n and time step throughout), is the
+shot scripts/validate_sampler runs as shots/v300_b<k> (kept in results/sampler/shots/v300_b<k>/ with its
+thinned series; the same run serves the sampler's validation); `floorF` runs the stiffness schedule
+(docs/model.md section 17) with k_n never below F times the scene's. Outputs at 0.2 s and their margins
+(B4): the grains in horn segments 1 and 2 (15 % each) and the crater depth (5 %); the ejected grains are
+reported beside. Wall times compare whole shots (0.25 s each).
 
-Each finished run's summary.json is kept as results/bench/sampler_floor/SETTING_rN.json (a kept run is
-not run again: the study resumes on any machine once they are committed).
+Each finished floored run's summary.json, with its outputs at 0.2 s, is kept as
+results/bench/sampler_floor/SETTING_bK.json (a kept run is not run again: the study resumes on any
+machine once they are committed).
 Environment: REGOLITH_BIN (default build/devel/lib/regolith_twin)."""
 import argparse
 import csv
@@ -27,44 +31,94 @@ from kept_run import run_kept  # noqa: E402
 from stats import mean_sd, paired_difference  # noqa: E402
 
 KEEP = os.path.join(ROOT, "results", "bench", "sampler_floor")
+SHOTS = os.path.join(ROOT, "results", "sampler", "shots")
 OUT = os.path.join(ROOT, "out", "bench", "sampler_floor")
 DOCS = os.path.join(ROOT, "docs", "bench")
 SCENE = os.path.join(ROOT, "config", "sampler_shot.yaml")
-DURATION = 0.2
+DURATION = 0.25       # every shot runs this long after firing, s
+AT = 0.2              # ... and is compared at this time, s
+AT_TOLERANCE = 1e-3   # the series row read must lie this close to AT, s
+BEDS = {1: "beds/sampler_gravel.bed", 2: "beds/sampler_gravel_s2.bed", 3: "beds/sampler_gravel_s3.bed"}
 # name -> (what, [--set ...])
-SETTINGS = {"off": ("reference: the scene's k_n and time step throughout", [])}
+SETTINGS = {"off": ("reference: the scene's k_n and time step throughout (scripts/validate_sampler shots)", [])}
 for floor in (1e-2, 1e-3):
     SETTINGS["floor%g" % floor] = ("stiffness schedule, k_n not below %g of the scene's" % floor,
                                    ["schedule.enabled=true", "schedule.floor=%g" % floor])
-# output label, reader, relative margin
-OUTPUTS = [("horn segment 1 (grains)", lambda s: s["observers"]["horn"]["segment_grains"][0], 0.15),
-           ("horn segment 2 (grains)", lambda s: s["observers"]["horn"]["segment_grains"][1], 0.15),
-           ("crater depth (m)", lambda s: s["observers"]["crater"]["depth"], 0.05),
-           ("ejected grains", lambda s: s["observers"]["ejection"]["count"], None)]
+# output label, series column, relative margin
+OUTPUTS = [("horn segment 1 (grains)", "seg1_n", 0.15),
+           ("horn segment 2 (grains)", "seg2_n", 0.15),
+           ("crater depth (m)", "crater_depth", 0.05),
+           ("ejected grains", "ejected_grains", None)]
 
 
-def run(names, repeats, threads):
+def at_time(series):
+    """{column: value} of the series row nearest AT (a CSV file with a header), or None when no row lies
+    within AT_TOLERANCE of it."""
+    if not os.path.exists(series):
+        return None
+    with open(series) as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        return None
+    best = min(rows, key=lambda r: abs(float(r["t"]) - AT))
+    if abs(float(best["t"]) - AT) > AT_TOLERANCE:
+        return None
+    return {k: float(v) for k, v in best.items()}
+
+
+def reference(bed):
+    """The reference shot on bed k (results/sampler/shots/v300_b<k>): its summary with its outputs at AT
+    under bench.at, or None when it has not been run."""
+    d = os.path.join(SHOTS, "v300_b%d" % bed)
+    f = os.path.join(d, "summary.json")
+    if not os.path.exists(f):
+        return None
+    s = json.load(open(f))
+    at = at_time(os.path.join(d, "series_thin.csv"))
+    if s.get("status") != "ok" or at is None:
+        return None
+    s["bench"] = {"setting": "off", "bed": bed, "at": at, "command": "scripts/validate_sampler shots/v300_b%d" % bed}
+    return s
+
+
+def run(names, beds, threads):
     bin_dir = os.environ.get("REGOLITH_BIN", os.path.join(ROOT, "build", "devel", "lib", "regolith_twin"))
     os.makedirs(KEEP, exist_ok=True)
-    for r in repeats:
+    for b in beds:
+        if "off" in names and reference(b) is None:
+            print("off b%d: not run yet (scripts/validate_sampler shots/v300_b%d runs it)" % (b, b), flush=True)
         for name in names:
-            keep = os.path.join(KEEP, "%s_r%d.json" % (name, r))
-            cmd = [os.path.join(bin_dir, "regolith_sim"), SCENE, "--out", os.path.join(OUT, "%s_r%d" % (name, r)),
-                   "--threads", str(threads), "--quiet", "--set", "sampler.duration=%g" % DURATION,
-                   "--set", "sampler.repeat=%d" % r]
+            if name == "off":
+                continue
+            keep = os.path.join(KEEP, "%s_b%d.json" % (name, b))
+            out = os.path.join(OUT, "%s_b%d" % (name, b))
+            cmd = [os.path.join(bin_dir, "regolith_sim"), SCENE, "--out", out, "--threads", str(threads), "--quiet",
+                   "--set", "sampler.duration=%g" % DURATION, "--set", "grains.0.file=%s" % BEDS[b]]
             for o in SETTINGS[name][1]:
                 cmd += ["--set", o]
-            s, ran = run_kept(cmd, keep, "bench", {"setting": name, "repeat": r, "threads": threads}, ROOT)
+            s, ran = run_kept(cmd, keep, "bench", {"setting": name, "bed": b, "threads": threads}, ROOT)
             if s is None or not ran:
                 continue
-            print("%s r%d: %s, %.0f s" % (name, r, ", ".join("%s %g" % (lab, get(s)) for lab, get, _ in OUTPUTS),
-                                          s["run"]["wall_seconds"]), flush=True)
+            at = at_time(os.path.join(out, "series.csv"))
+            if at is None:
+                print("%s b%d: no series row within %g s of %g s" % (name, b, AT_TOLERANCE, AT), flush=True)
+                os.remove(keep)
+                continue
+            s["bench"]["at"] = at
+            with open(keep + ".tmp", "w") as f:
+                json.dump(s, f, indent=1)
+            os.replace(keep + ".tmp", keep)
+            print("%s b%d: %s at %g s, %.0f s" % (name, b, ", ".join("%s %g" % (lab, at[col]) for lab, col, _ in OUTPUTS),
+                                                  AT, s["run"]["wall_seconds"]), flush=True)
 
 
 def load(name):
+    """bed -> summary (with bench.at) of every kept run of a setting."""
+    if name == "off":
+        return {b: r for b, r in ((b, reference(b)) for b in BEDS) if r is not None}
     runs = {}
     for f in sorted(os.listdir(KEEP)) if os.path.isdir(KEEP) else []:
-        if f.startswith(name + "_r") and f.endswith(".json"):
+        if f.startswith(name + "_b") and f.endswith(".json"):
             runs[int(f[len(name) + 2:-5])] = json.load(open(os.path.join(KEEP, f)))
     return runs
 
@@ -74,7 +128,8 @@ def report():
     lines = ["<!-- generated by bench/sampler_floor.py report -->", ""]
     if ref:
         lines += ["Reference (`off`), %d beds: " % len(ref) + "; ".join(
-            "%s %.4g ± %.2g (SD)" % (lab, *mean_sd([get(s) for s in ref.values()])) for lab, get, _ in OUTPUTS) +
+            "%s %.4g ± %.2g (SD)" % (lab, *mean_sd([s["bench"]["at"][col] for s in ref.values()]))
+            for lab, col, _ in OUTPUTS) +
             "; wall time %.0f s per shot." % mean_sd([s["run"]["wall_seconds"] for s in ref.values()])[0], ""]
     lines += ["| setting | what | beds | wall (s) | faster than `off` | " +
               " | ".join("%s: relative difference, 95 %% CI%s" % (lab, " (margin ±%g)" % m if m else "")
@@ -90,12 +145,13 @@ def report():
                  mean_sd([runs[r]["run"]["wall_seconds"] for r in pairs])[0]) if pairs else float("nan")
         cells = ["`%s`" % name, what, str(len(pairs)), "%.0f" % wall, "%.1f×" % speed]
         row = [name, len(pairs), "%.1f" % wall, "%.3f" % speed]
-        for lab, get, margin in OUTPUTS:
+        for lab, col, margin in OUTPUTS:
             if not pairs:
                 cells.append("–")
                 row += ["NA"] * 4
                 continue
-            m, half = paired_difference([get(ref[r]) for r in pairs], [get(runs[r]) for r in pairs], relative=True)
+            m, half = paired_difference([ref[r]["bench"]["at"][col] for r in pairs],
+                                        [runs[r]["bench"]["at"][col] for r in pairs], relative=True)
             ok = margin is not None and abs(m) + half <= margin
             cells.append("%+.3f [%+.3f, %+.3f]%s" % (m, m - half, m + half,
                                                      "" if margin is None else (" ✓" if ok else " ✗")))
@@ -118,25 +174,25 @@ def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("cmd", choices=["run", "report", "list"])
     p.add_argument("settings", nargs="*")
-    p.add_argument("--repeats", default="0,1,2")
+    p.add_argument("--beds", default="1,2,3")
     p.add_argument("--threads", type=int, default=2)
     a = p.parse_args()
     try:
-        repeats = [int(r) for r in a.repeats.split(",") if r]
+        beds = [int(b) for b in a.beds.split(",") if b]
     except ValueError:
-        raise SystemExit("sampler_floor: --repeats takes numbers, e.g. 0,1,2")
-    if any(r < 0 for r in repeats):
-        raise SystemExit("sampler_floor: a repeat is 0 or more")
+        raise SystemExit("sampler_floor: --beds takes bed numbers, e.g. 1,2,3")
+    if any(b not in BEDS for b in beds):
+        raise SystemExit("sampler_floor: the beds are %s" % ", ".join(str(b) for b in BEDS))
     for s in a.settings:
         if s not in SETTINGS:
             raise SystemExit("sampler_floor: unknown setting '%s' (known: %s)" % (s, ", ".join(SETTINGS)))
     if a.cmd == "run":
-        run(a.settings or list(SETTINGS), repeats, a.threads)
+        run(a.settings or list(SETTINGS), beds, a.threads)
     elif a.cmd == "report":
         report()
     else:
         for name, (what, _) in SETTINGS.items():
-            print("%-10s %-60s kept: %s" % (name, what, ", ".join("r%d" % r for r in sorted(load(name))) or "none"))
+            print("%-10s %-60s kept: %s" % (name, what, ", ".join("b%d" % b for b in sorted(load(name))) or "none"))
 
 
 if __name__ == "__main__":

@@ -30,14 +30,23 @@ RUN = re.compile(r"^c(\d+)_r(\d+)$")
 SHOT = re.compile(r"^v(\d+)(_1s)?_b(\d+)$")
 
 
+MARKS = (0.2,)  # times whose nearest row a thinned series always keeps (bench/sampler_floor.py reads 0.2 s), s
+
+
 def thin(src, dst, rows_max=400):
+    """src's rows thinned to about rows_max, the last row and the rows nearest MARKS kept."""
     with open(src) as f:
         rows = list(csv.reader(f))
     head, body = rows[0], rows[1:]
     step = max(1, math.ceil(len(body) / rows_max))
-    keep = body[::step]
-    if body and keep[-1] is not body[-1]:
-        keep.append(body[-1])
+    picked = set(range(0, len(body), step))
+    if body:
+        picked.add(len(body) - 1)
+        t = [float(r[0]) for r in body]
+        for mark in MARKS:
+            if t[0] <= mark <= t[-1]:
+                picked.add(min(range(len(t)), key=lambda k: abs(t[k] - mark)))
+    keep = [body[k] for k in sorted(picked)]
     with open(dst, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(head)

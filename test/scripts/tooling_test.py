@@ -2,6 +2,9 @@
 """The shared tooling of the campaign, report and benchmark scripts (scripts/lib): statistics and fits
 against exact numbers, the CSV readers on files with comments, and the campaigns' command line."""
 import contextlib
+import csv
+import importlib.util
+import json
 import io
 import math
 import os
@@ -149,6 +152,62 @@ class KeptRuns(unittest.TestCase):
             self.assertTrue(ran)
             self.assertIn("exit 3", said.getvalue())
             self.assertFalse(os.path.exists(keep))
+
+
+class SamplerFloorPairs(unittest.TestCase):
+    """The floor study reads every shot at 0.2 s (the series row nearest it) and pairs bed with bed; the
+    reference is the validation's shot on each shipped bed, and a thinned series keeps the 0.2 s row."""
+
+    def setUp(self):
+        spec = importlib.util.spec_from_file_location(
+            "sampler_floor", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "bench",
+                                          "sampler_floor.py"))
+        self.sf = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(self.sf)
+
+    @staticmethod
+    def series(path, seg1, crater, dt=1.37e-4):
+        # seg1 and crater rise linearly with time; rows every dt up to 0.25 s.
+        with open(path, "w") as f:
+            f.write("t,seg1_n,seg2_n,crater_depth,ejected_grains\n")
+            for k in range(int(0.25 / dt) + 1):
+                t = k * dt
+                f.write("%.9g,%.9g,%.9g,%.9g,%.9g\n" % (t, seg1 * t / 0.2, 50, crater * t / 0.2, 1000))
+
+    def test_references_floors_and_pairs(self):
+        import sampler_campaign
+        with tempfile.TemporaryDirectory() as t:
+            sf = self.sf
+            sf.SHOTS, sf.KEEP, sf.DOCS = os.path.join(t, "shots"), os.path.join(t, "keep"), t
+            for b, (seg1, crater) in {1: (100, 0.10), 2: (120, 0.11), 3: (80, 0.09)}.items():
+                d = os.path.join(sf.SHOTS, "v300_b%d" % b)
+                os.makedirs(d)
+                self.series(os.path.join(t, "full.csv"), seg1, crater)
+                sampler_campaign.thin(os.path.join(t, "full.csv"), os.path.join(d, "series_thin.csv"))
+                json.dump({"status": "ok", "run": {"wall_seconds": 3000.0}}, open(os.path.join(d, "summary.json"), "w"))
+                # The floored shot: 10 % more grains in segment 1, the same crater, ten times faster.
+                os.makedirs(sf.KEEP, exist_ok=True)
+                at = sf.at_time(os.path.join(t, "full.csv"))
+                at["seg1_n"] *= 1.1
+                json.dump({"status": "ok", "run": {"wall_seconds": 300.0}, "bench": {"at": at}},
+                          open(os.path.join(sf.KEEP, "floor0.01_b%d.json" % b), "w"))
+            ref = sf.load("off")
+            self.assertEqual(sorted(ref), [1, 2, 3])
+            self.assertAlmostEqual(ref[2]["bench"]["at"]["seg1_n"], 120, delta=120 * 1e-3 / 0.2)
+            with contextlib.redirect_stdout(io.StringIO()):
+                sf.report()
+            rows = {r[0]: r for r in csv.reader(open(os.path.join(t, "sampler_floor.csv")))}
+            head = rows["setting"]
+            row = rows["floor0.01"]
+            self.assertEqual(row[head.index("beds")], "3")
+            self.assertAlmostEqual(float(row[head.index("wall_ratio_to_off")]), 10.0)
+            self.assertAlmostEqual(float(row[head.index("segment1_rel_diff")]), 0.1, places=3)
+            self.assertEqual(row[head.index("segment1_within")], "1")  # +10 % [exactly, no spread] inside 15 %
+            self.assertAlmostEqual(float(row[head.index("crater_depth_rel_diff")]), 0.0, places=9)
+            # A series with no row near 0.2 s gives nothing to compare.
+            with open(os.path.join(t, "short.csv"), "w") as f:
+                f.write("t,seg1_n\n0,0\n0.1,5\n")
+            self.assertIsNone(sf.at_time(os.path.join(t, "short.csv")))
 
 
 class Gate(unittest.TestCase):

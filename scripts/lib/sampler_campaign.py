@@ -192,14 +192,9 @@ def main():
     out, docs = a.out, a.docs
     runs = collect(out, docs, RUN, lambda m: (int(m.group(1)), int(m.group(2))))
     sdocs, sout = os.path.join(docs, "shots"), os.path.join(out, "shots")
-    shots = {d: collect(sout, sdocs, SHOT, lambda m: (int(m.group(1)), int(m.group(3))))
+    every = collect(sout, sdocs, SHOT, lambda m: (int(m.group(1)), int(m.group(3))))
+    shots = {d: {n: r for n, r in every.items() if bool(SHOT.match(n).group(2)) == (d == "1 s")}
              for d in ("0.25 s", "1 s")}
-    for name in list(shots["0.25 s"]):
-        if SHOT.match(name).group(2):
-            shots["1 s"][name] = shots["0.25 s"].pop(name)
-    for name in list(shots["1 s"]):
-        if not SHOT.match(name).group(2):
-            del shots["1 s"][name]
     if not runs and not any(shots.values()):
         sys.exit(f"sampler_campaign: no campaign runs (c<speed>_r<repeat>/summary.json) or shots "
                  f"(shots/v<speed>[_1s]_b<bed>/summary.json) in {docs}")

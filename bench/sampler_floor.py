@@ -141,8 +141,10 @@ def report():
             continue
         pairs = sorted(set(ref) & set(runs))
         wall = mean_sd([runs[r]["run"]["wall_seconds"] for r in runs])[0]
-        speed = (mean_sd([ref[r]["run"]["wall_seconds"] for r in pairs])[0] /
-                 mean_sd([runs[r]["run"]["wall_seconds"] for r in pairs])[0]) if pairs else float("nan")
+        # Wall times compare only where both shots ran on as many threads.
+        timed = [r for r in pairs if ref[r]["run"].get("threads") == runs[r]["run"].get("threads")]
+        speed = (mean_sd([ref[r]["run"]["wall_seconds"] for r in timed])[0] /
+                 mean_sd([runs[r]["run"]["wall_seconds"] for r in timed])[0]) if timed else float("nan")
         cells = ["`%s`" % name, what, str(len(pairs)), "%.0f" % wall, "%.1f×" % speed]
         row = [name, len(pairs), "%.1f" % wall, "%.3f" % speed]
         for lab, col, margin in OUTPUTS:

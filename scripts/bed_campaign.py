@@ -179,16 +179,17 @@ def cases():
     out = {}
     for mat in MATERIALS:
         mo = ["materials.regolith.preset=%s" % mat, "materials.container.preset=%s" % mat]
-        out["lattice_%s" % mat] = (mat, mo + ["grains.0.fill.arrangement=lattice"])
+        out["lattice_%s" % mat] = (mat, mo + ["grains.0.fill.arrangement=lattice"], SMALL, 1.0)
         # A control: the lattice spread out (4 cm apart) with a jitter as large as the room allows,
         # so that grains of a column no longer stand on each other.
         out["lattice_wide_%s" % mat] = (mat, mo + ["grains.0.fill.arrangement=lattice", "grains.0.fill.spacing=0.04",
-                                                   "grains.0.fill.jitter=0.0067", "grains.0.fill.z=[0.0,2.0]"])
+                                                   "grains.0.fill.jitter=0.0067", "grains.0.fill.z=[0.0,2.0]"],
+                                           SMALL, 1.0)
         for f in FRACTIONS:
             top = N_SMALL * mean_volume() / (math.pi * R_SMALL ** 2 * f)
             for seed in SEEDS:
                 out["random_%s_f%.2f_s%d" % (mat, f, seed)] = (
-                    mat, mo + ["grains.0.fill.z=[0.0,%.4f]" % top, "seed=%d" % seed])
+                    mat, mo + ["grains.0.fill.z=[0.0,%.4f]" % top, "seed=%d" % seed], SMALL, 1.0)
     # The same pour with the sampler's grains on a bed scaled to them: is the packing set by the
     # region's height in grain radii (the sampler bed's region is 2.6 times the MASCOT 30 cm bed's
     # in those units at the same f), whatever the grains' size, stiffness and wall restitution?
@@ -198,7 +199,7 @@ def cases():
         for seed in SEEDS:
             out["sampler_grains_f%.2f_s%d" % (f, seed)] = (
                 "gravel", ["grains.0.fill.z=[0.0,%.4f]" % top, "seed=%d" % seed], SMALL_SAMPLER, SAMPLER_SCALE)
-    return {k: v if len(v) == 4 else v + (SMALL, 1.0) for k, v in out.items()}
+    return out
 
 
 def cap_volume(r, h):

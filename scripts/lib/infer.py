@@ -25,7 +25,6 @@ import json
 import math
 import os
 import re
-
 import sys
 
 from scipy.stats import chi2 as chi2_dist

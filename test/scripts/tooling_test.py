@@ -184,12 +184,15 @@ class SamplerFloorPairs(unittest.TestCase):
                 os.makedirs(d)
                 self.series(os.path.join(t, "full.csv"), seg1, crater)
                 sampler_campaign.thin(os.path.join(t, "full.csv"), os.path.join(d, "series_thin.csv"))
-                json.dump({"status": "ok", "run": {"wall_seconds": 3000.0}}, open(os.path.join(d, "summary.json"), "w"))
+                json.dump({"status": "ok", "run": {"wall_seconds": 3000.0, "threads": 2}},
+                          open(os.path.join(d, "summary.json"), "w"))
                 # The floored shot: 10 % more grains in segment 1, the same crater, ten times faster.
                 os.makedirs(sf.KEEP, exist_ok=True)
                 at = sf.at_time(os.path.join(t, "full.csv"))
                 at["seg1_n"] *= 1.1
-                json.dump({"status": "ok", "run": {"wall_seconds": 300.0}, "bench": {"at": at}},
+                # Bed 3's floored shot ran on one thread: its wall time (here 100 s) must not enter the ratio.
+                run = {"wall_seconds": 300.0, "threads": 2} if b < 3 else {"wall_seconds": 100.0, "threads": 1}
+                json.dump({"status": "ok", "run": run, "bench": {"at": at}},
                           open(os.path.join(sf.KEEP, "floor0.01_b%d.json" % b), "w"))
             ref = sf.load("off")
             self.assertEqual(sorted(ref), [1, 2, 3])
@@ -200,7 +203,7 @@ class SamplerFloorPairs(unittest.TestCase):
             head = rows["setting"]
             row = rows["floor0.01"]
             self.assertEqual(row[head.index("beds")], "3")
-            self.assertAlmostEqual(float(row[head.index("wall_ratio_to_off")]), 10.0)
+            self.assertAlmostEqual(float(row[head.index("wall_ratio_to_off")]), 10.0)  # bed 3 ran on 1 thread: not timed
             self.assertAlmostEqual(float(row[head.index("segment1_rel_diff")]), 0.1, places=3)
             self.assertEqual(row[head.index("segment1_within")], "1")  # +10 % [exactly, no spread] inside 15 %
             self.assertAlmostEqual(float(row[head.index("crater_depth_rel_diff")]), 0.0, places=9)

@@ -154,6 +154,11 @@ def report():
                 continue
             m, half = paired_difference([ref[r]["bench"]["at"][col] for r in pairs],
                                         [runs[r]["bench"]["at"][col] for r in pairs], relative=True)
+            if len(pairs) < 2:
+                # One bed gives a difference but no interval: no verdict against the margin.
+                cells.append("%+.3f (one bed: no interval)" % m)
+                row += ["%.5g" % m, "NA", "NA", "NA"]
+                continue
             ok = margin is not None and abs(m) + half <= margin
             cells.append("%+.3f [%+.3f, %+.3f]%s" % (m, m - half, m + half,
                                                      "" if margin is None else (" ✓" if ok else " ✗")))

@@ -207,6 +207,17 @@ class SamplerFloorPairs(unittest.TestCase):
             self.assertAlmostEqual(float(row[head.index("segment1_rel_diff")]), 0.1, places=3)
             self.assertEqual(row[head.index("segment1_within")], "1")  # +10 % [exactly, no spread] inside 15 %
             self.assertAlmostEqual(float(row[head.index("crater_depth_rel_diff")]), 0.0, places=9)
+            # With one bed paired there is a difference but no interval, and no verdict.
+            for b in (2, 3):
+                os.remove(os.path.join(sf.KEEP, "floor0.01_b%d.json" % b))
+            with contextlib.redirect_stdout(io.StringIO()):
+                sf.report()
+            rows = {r[0]: r for r in csv.reader(open(os.path.join(t, "sampler_floor.csv")))}
+            row = rows["floor0.01"]
+            self.assertEqual(row[head.index("beds")], "1")
+            self.assertAlmostEqual(float(row[head.index("segment1_rel_diff")]), 0.1, places=3)
+            self.assertEqual([row[head.index("segment1_" + k)] for k in ("ci_lo", "ci_hi", "within")], ["NA"] * 3)
+            self.assertIn("one bed: no interval", open(os.path.join(t, "sampler_floor.md")).read())
             # A series with no row near 0.2 s gives nothing to compare.
             with open(os.path.join(t, "short.csv"), "w") as f:
                 f.write("t,seg1_n\n0,0\n0.1,5\n")

@@ -11,8 +11,8 @@ most 400 rows, kept with the run's summary); then DOCS_DIR/campaign.md (one
 row per shot, mean and SD per speed) and DOCS_DIR/campaign_*.png (collected
 mass, crater depth and radius, grains in the horn against time; ejection
 angle histograms) are written from DOCS_DIR. The same for the shots
-shots/v<speed>[_1s]_b<bed> (to 0.25 s at the scene's stiffness, or 1 s with
-the stiffness schedule, on the shipped bed <bed>): DOCS_DIR/shots/report.md
+shots/v<speed>[_1s]_b<bed>[r<repeat>] (to 0.25 s at the scene's stiffness, or 1 s
+with the stiffness schedule, on the shipped bed <bed>, turned as perturbed repeat <repeat>): DOCS_DIR/shots/report.md
 and DOCS_DIR/shots/shots_*.png, one table and one set of plots per duration.
 """
 import argparse
@@ -27,7 +27,7 @@ from plots import pyplot, save_figure
 from stats import mean_sd
 
 RUN = re.compile(r"^c(\d+)_r(\d+)$")
-SHOT = re.compile(r"^v(\d+)(_1s)?_b(\d+)$")
+SHOT = re.compile(r"^v(\d+)(_1s)?_b(\d+)(?:r(\d+))?$")
 
 
 MARKS = (0.2,)  # times whose nearest row a thinned series always keeps (bench/sampler_floor.py reads 0.2 s), s
@@ -153,12 +153,15 @@ def write(runs, docs, md, prefix, bed_word, end_word):
     colours = {300: "tab:red", 50: "tab:blue"}
     styles = ["-", "--", ":", "-."]
     fig, ax = plt.subplots(2, 2, figsize=(11, 7.5))
+    place = {}  # a line style per run: its place among the runs at its speed
+    for name, (v, rep, s, o) in runs.items():
+        place[name] = sum(1 for r in place if runs[r][0] == v)
     for name, (v, rep, s, o) in runs.items():
         ser = read_series(os.path.join(docs, name, "series_thin.csv"))
         if ser is None:
             continue
         t = ser["t"]
-        kw = dict(color=colours.get(v, "k"), ls=styles[rep % len(styles)], label=f"{v} m/s, {bed_word} {rep}")
+        kw = dict(color=colours.get(v, "k"), ls=styles[place[name] % len(styles)], label=f"{v} m/s, {bed_word} {rep}")
         ax[0][0].plot(t, [1e6 * x for x in ser["collected_mass"]], **kw)
         ax[0][1].plot(t, [sum(ser[f"seg{k}_n"][i] for k in range(1, 6)) for i in range(len(t))], **kw)
         ax[1][0].plot(t, [1e3 * x for x in ser["crater_depth"]], **kw)
@@ -177,7 +180,7 @@ def write(runs, docs, md, prefix, bed_word, end_word):
             continue
         tot = float(sum(h)) or 1.0
         ax.step([b * (i + 0.5) for i in range(len(h))], [x / tot for x in h], where="mid",
-                color=colours.get(v, "k"), ls=styles[rep % len(styles)], label=f"{v} m/s, {bed_word} {rep}")
+                color=colours.get(v, "k"), ls=styles[place[name] % len(styles)], label=f"{v} m/s, {bed_word} {rep}")
     ax.set_xlabel("ejection angle from the horizontal (deg)")
     ax.set_ylabel("fraction of ejected grains")
     ax.legend(fontsize=8)
@@ -192,7 +195,8 @@ def main():
     out, docs = a.out, a.docs
     runs = collect(out, docs, RUN, lambda m: (int(m.group(1)), int(m.group(2))))
     sdocs, sout = os.path.join(docs, "shots"), os.path.join(out, "shots")
-    every = collect(sout, sdocs, SHOT, lambda m: (int(m.group(1)), int(m.group(3))))
+    every = collect(sout, sdocs, SHOT, lambda m: (int(m.group(1)), m.group(3) + (
+        " (turned, repeat %s)" % m.group(4) if m.group(4) else "")))
     shots = {d: {n: r for n, r in every.items() if bool(SHOT.match(n).group(2)) == (d == "1 s")}
              for d in ("0.25 s", "1 s")}
     if not runs and not any(shots.values()):

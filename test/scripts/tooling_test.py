@@ -224,6 +224,19 @@ class SamplerFloorPairs(unittest.TestCase):
             self.assertIsNone(sf.at_time(os.path.join(t, "short.csv")))
 
 
+class SamplerShotNames(unittest.TestCase):
+    """Shots on the shipped beds are named v<speed>[_1s]_b<bed>[r<repeat>]; a turned repeat keeps its bed."""
+
+    def test_names(self):
+        import sampler_campaign
+        m = sampler_campaign.SHOT.match("v300_1s_b2r1")
+        self.assertEqual((m.group(1), bool(m.group(2)), m.group(3), m.group(4)), ("300", True, "2", "1"))
+        m = sampler_campaign.SHOT.match("v50_b3")
+        self.assertEqual((m.group(1), bool(m.group(2)), m.group(3), m.group(4)), ("50", False, "3", None))
+        for bad in ("v300_1s_b", "v300_1s_b1r", "v300_2s_b1", "c300_r0"):
+            self.assertIsNone(sampler_campaign.SHOT.match(bad), bad)
+
+
 class Gate(unittest.TestCase):
     def write(self, d, files):
         for name, text in files.items():

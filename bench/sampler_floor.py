@@ -11,7 +11,9 @@ runs to 0.25 s after firing on bed k as prepared and is compared at 0.2 s, read 
 nearest 0.2 s). The reference, `off` (every saving off: the scene's k_n and time step throughout), is the
 shot scripts/validate_sampler runs as shots/v300_b<k> (kept in results/sampler/shots/v300_b<k>/ with its
 thinned series; the same run serves the sampler's validation); `floorF` runs the stiffness schedule
-(docs/model.md section 17) with k_n never below F times the scene's. Outputs at 0.2 s and their margins
+(docs/model.md section 17) with k_n never below F times the scene's; `schedule`, the schedule as shipped
+(floor 1e-4), is not run here but read at 0.2 s from the validation's 1 s shots on the same beds
+(shots/v300_1s_b<k>: one thread, 1 s, so their wall times are not compared). Outputs at 0.2 s and their margins
 (B4): the grains in horn segments 1 and 2 (15 % each) and the crater depth (5 %); the ejected grains are
 reported beside. Wall times compare whole shots (0.25 s each).
 
@@ -40,7 +42,13 @@ AT = 0.2              # ... and is compared at this time, s
 AT_TOLERANCE = 1e-3   # the series row read must lie this close to AT, s
 BEDS = {1: "beds/sampler_gravel.bed", 2: "beds/sampler_gravel_s2.bed", 3: "beds/sampler_gravel_s3.bed"}
 # name -> (what, [--set ...])
-SETTINGS = {"off": ("reference: the scene's k_n and time step throughout (scripts/validate_sampler shots)", [])}
+SETTINGS = {"off": ("reference: the scene's k_n and time step throughout (scripts/validate_sampler shots)", []),
+            # Not run by the study: the validation's 1 s shots on the same beds, read at AT (they ran on one
+            # thread and for 1 s, so their wall times are not compared).
+            "schedule": ("stiffness schedule as shipped, k_n not below 1e-4 of the scene's (the sampler "
+                         "validation's 1 s shots)", None)}
+# The validation's shots each setting not run here reads: setting -> run name on bed k
+SHOT_OF = {"off": "v300_b%d", "schedule": "v300_1s_b%d"}
 for floor in (1e-2, 1e-3):
     SETTINGS["floor%g" % floor] = ("stiffness schedule, k_n not below %g of the scene's" % floor,
                                    ["schedule.enabled=true", "schedule.floor=%g" % floor])
@@ -66,10 +74,11 @@ def at_time(series):
     return {k: float(v) for k, v in best.items()}
 
 
-def reference(bed):
-    """The reference shot on bed k (results/sampler/shots/v300_b<k>): its summary with its outputs at AT
-    under bench.at, or None when it has not been run."""
-    d = os.path.join(SHOTS, "v300_b%d" % bed)
+def validation_shot(name, bed):
+    """The sampler validation's shot a setting reads on bed k (SHOT_OF: results/sampler/shots/v300_b<k> for
+    the reference): its summary with its outputs at AT under bench.at, or None when it has not been run."""
+    run_name = SHOT_OF[name] % bed
+    d = os.path.join(SHOTS, run_name)
     f = os.path.join(d, "summary.json")
     if not os.path.exists(f):
         return None
@@ -77,18 +86,24 @@ def reference(bed):
     at = at_time(os.path.join(d, "series_thin.csv"))
     if s.get("status") != "ok" or at is None:
         return None
-    s["bench"] = {"setting": "off", "bed": bed, "at": at, "command": "scripts/validate_sampler shots/v300_b%d" % bed}
+    s["bench"] = {"setting": name, "bed": bed, "at": at, "command": "scripts/validate_sampler shots/" + run_name}
     return s
+
+
+def reference(bed):
+    """The reference shot on bed k (results/sampler/shots/v300_b<k>), as validation_shot()."""
+    return validation_shot("off", bed)
 
 
 def run(names, beds, threads):
     bin_dir = os.environ.get("REGOLITH_BIN", os.path.join(ROOT, "build", "devel", "lib", "regolith_twin"))
     os.makedirs(KEEP, exist_ok=True)
     for b in beds:
-        if "off" in names and reference(b) is None:
-            print("off b%d: not run yet (scripts/validate_sampler shots/v300_b%d runs it)" % (b, b), flush=True)
         for name in names:
-            if name == "off":
+            if name in SHOT_OF:
+                if validation_shot(name, b) is None:
+                    print("%s b%d: not run yet (scripts/validate_sampler shots/%s runs it)" %
+                          (name, b, SHOT_OF[name] % b), flush=True)
                 continue
             keep = os.path.join(KEEP, "%s_b%d.json" % (name, b))
             out = os.path.join(OUT, "%s_b%d" % (name, b))
@@ -114,8 +129,8 @@ def run(names, beds, threads):
 
 def load(name):
     """bed -> summary (with bench.at) of every kept run of a setting."""
-    if name == "off":
-        return {b: r for b, r in ((b, reference(b)) for b in BEDS) if r is not None}
+    if name in SHOT_OF:
+        return {b: r for b, r in ((b, validation_shot(name, b)) for b in BEDS) if r is not None}
     runs = {}
     for f in sorted(os.listdir(KEEP)) if os.path.isdir(KEEP) else []:
         if f.startswith(name + "_b") and f.endswith(".json"):
@@ -127,8 +142,11 @@ def report():
     ref = load("off")
     lines = ["<!-- generated by bench/sampler_floor.py report -->", ""]
     if ref:
-        lines += ["Reference (`off`), %d beds: " % len(ref) + "; ".join(
-            "%s %.4g ± %.2g (SD)" % (lab, *mean_sd([s["bench"]["at"][col] for s in ref.values()]))
+        def mean_text(values):
+            m, sd = mean_sd(values)
+            return "%.4g ± %.2g (SD)" % (m, sd) if len(values) > 1 else "%.4g" % m
+        lines += ["Reference (`off`), %d bed%s: " % (len(ref), "s" if len(ref) > 1 else "") + "; ".join(
+            "%s %s" % (lab, mean_text([s["bench"]["at"][col] for s in ref.values()]))
             for lab, col, _ in OUTPUTS) +
             "; wall time %.0f s per shot." % mean_sd([s["run"]["wall_seconds"] for s in ref.values()])[0], ""]
     lines += ["| setting | what | beds | wall (s) | faster than `off` | " +
@@ -140,13 +158,17 @@ def report():
         if name == "off" or not runs:
             continue
         pairs = sorted(set(ref) & set(runs))
-        wall = mean_sd([runs[r]["run"]["wall_seconds"] for r in runs])[0]
-        # Wall times compare only where both shots ran on as many threads.
-        timed = [r for r in pairs if ref[r]["run"].get("threads") == runs[r]["run"].get("threads")]
-        speed = (mean_sd([ref[r]["run"]["wall_seconds"] for r in timed])[0] /
-                 mean_sd([runs[r]["run"]["wall_seconds"] for r in timed])[0]) if timed else float("nan")
-        cells = ["`%s`" % name, what, str(len(pairs)), "%.0f" % wall, "%.1f×" % speed]
-        row = [name, len(pairs), "%.1f" % wall, "%.3f" % speed]
+        if name in SHOT_OF:  # shots of another length: their wall times are not this study's
+            cells = ["`%s`" % name, what, str(len(pairs)), "–", "–"]
+            row = [name, len(pairs), "NA", "NA"]
+        else:
+            wall = mean_sd([runs[r]["run"]["wall_seconds"] for r in runs])[0]
+            # Wall times compare only where both shots ran on as many threads.
+            timed = [r for r in pairs if ref[r]["run"].get("threads") == runs[r]["run"].get("threads")]
+            speed = (mean_sd([ref[r]["run"]["wall_seconds"] for r in timed])[0] /
+                     mean_sd([runs[r]["run"]["wall_seconds"] for r in timed])[0]) if timed else float("nan")
+            cells = ["`%s`" % name, what, str(len(pairs)), "%.0f" % wall, "%.1f×" % speed]
+            row = [name, len(pairs), "%.1f" % wall, "%.3f" % speed]
         for lab, col, margin in OUTPUTS:
             if not pairs:
                 cells.append("–")

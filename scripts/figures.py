@@ -280,7 +280,16 @@ def sampler():
         return got
 
     r300, r300_1s, r50, r50_1s = runs("v300"), runs("v300_1s"), runs("v50"), runs("v50_1s")
-    early = r300 + r300_1s  # both resolve the first milliseconds at the scene's stiffness
+    # The first milliseconds, one shot per bed (a turned repeat is a bed of its own): the shot at the scene's
+    # stiffness where the bed has one, else the 1 s shot, whose schedule lowers k_n only once the
+    # projectile has stopped.
+    def one_per_bed(preferred_last):
+        per_bed = {}
+        for d, s in preferred_last:
+            per_bed[os.path.basename(d).rsplit("_b", 1)[1]] = (d, s)
+        return [per_bed[b] for b in sorted(per_bed)]
+
+    early = one_per_bed(r300_1s + r300)
 
     def zfit(s, k, key):
         z = s["observers"].get("zmodel", {}).get("t%d" % k, {}).get("fixed_h0")
@@ -305,8 +314,9 @@ def sampler():
         b = s["observers"]["ejection"]["bin_deg"]
         return (max(range(len(h)), key=lambda k: h[k]) + 0.5) * b if sum(h) else None
 
-    out["sampler.v300.ejection_angle_mode"] = ([mode(s) for _, s in r300 + r300_1s], cmd)
-    out["sampler.v50.ejection_angle_mode"] = ([mode(s) for _, s in r50 + r50_1s], cmd)
+    # Ejection angles over the whole shot: the longest shot on each bed.
+    out["sampler.v300.ejection_angle_mode"] = ([mode(s) for _, s in one_per_bed(r300 + r300_1s)], cmd)
+    out["sampler.v50.ejection_angle_mode"] = ([mode(s) for _, s in one_per_bed(r50 + r50_1s)], cmd)
 
     def energy(d):
         f = os.path.join(d, "energy_partition.csv")

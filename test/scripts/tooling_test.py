@@ -194,6 +194,13 @@ class SamplerFloorPairs(unittest.TestCase):
                 run = {"wall_seconds": 300.0, "threads": 2} if b < 3 else {"wall_seconds": 100.0, "threads": 1}
                 json.dump({"status": "ok", "run": run, "bench": {"at": at}},
                           open(os.path.join(sf.KEEP, "floor0.01_b%d.json" % b), "w"))
+                # The validation's 1 s shot with the schedule as shipped (one thread, 1 s), 20 % deeper.
+                d = os.path.join(sf.SHOTS, "v300_1s_b%d" % b)
+                os.makedirs(d)
+                self.series(os.path.join(t, "full.csv"), seg1, crater * 1.2)
+                sampler_campaign.thin(os.path.join(t, "full.csv"), os.path.join(d, "series_thin.csv"))
+                json.dump({"status": "ok", "run": {"wall_seconds": 2000.0, "threads": 1}},
+                          open(os.path.join(d, "summary.json"), "w"))
             ref = sf.load("off")
             self.assertEqual(sorted(ref), [1, 2, 3])
             self.assertAlmostEqual(ref[2]["bench"]["at"]["seg1_n"], 120, delta=120 * 1e-3 / 0.2)
@@ -207,6 +214,11 @@ class SamplerFloorPairs(unittest.TestCase):
             self.assertAlmostEqual(float(row[head.index("segment1_rel_diff")]), 0.1, places=3)
             self.assertEqual(row[head.index("segment1_within")], "1")  # +10 % [exactly, no spread] inside 15 %
             self.assertAlmostEqual(float(row[head.index("crater_depth_rel_diff")]), 0.0, places=9)
+            row = rows["schedule"]  # read from the 1 s shots, not timed
+            self.assertEqual([row[head.index(k)] for k in ("beds", "wall_seconds", "wall_ratio_to_off")],
+                             ["3", "NA", "NA"])
+            self.assertAlmostEqual(float(row[head.index("crater_depth_rel_diff")]), 0.2, places=6)
+            self.assertEqual(row[head.index("crater_depth_within")], "0")
             # With one bed paired there is a difference but no interval, and no verdict.
             for b in (2, 3):
                 os.remove(os.path.join(sf.KEEP, "floor0.01_b%d.json" % b))

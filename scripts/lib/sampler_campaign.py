@@ -12,8 +12,9 @@ row per shot, mean and SD per speed) and DOCS_DIR/campaign_*.png (collected
 mass, crater depth and radius, grains in the horn against time; ejection
 angle histograms) are written from DOCS_DIR. The same for the shots
 shots/v<speed>[_1s]_b<bed>[r<repeat>] (to 0.25 s at the scene's stiffness, or 1 s
-with the stiffness schedule, on the shipped bed <bed>, turned as perturbed repeat <repeat>): DOCS_DIR/shots/report.md
-and DOCS_DIR/shots/shots_*.png, one table and one set of plots per duration.
+with the stiffness schedule, on the shipped bed <bed>, turned as perturbed
+repeat <repeat>): DOCS_DIR/shots/report.md and DOCS_DIR/shots/shots_*.png,
+one table and one set of plots per duration.
 """
 import argparse
 import csv

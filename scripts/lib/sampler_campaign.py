@@ -94,6 +94,9 @@ def outcome(s):
         "threads": s["run"].get("threads"),
         "steps": s["run"].get("steps"),
         "sim": s["run"].get("sim_time"),
+        # The stiffness schedule's raises (docs/model.md §17): how often, and the elastic energy they added.
+        "raised": s["run"].get("schedule", {}).get("raised"),
+        "injected_j": s["run"].get("schedule", {}).get("injected_energy"),
     }
 
 
@@ -120,8 +123,8 @@ def write(runs, docs, md, prefix, bed_word, end_word):
     lines = [
         "| shot | speed m/s | %s | collected %s mg | 100 mg reached at s | grains in horn (cyl. 1-5) | "
         "crater depth / radius mm | ejected grains (cm³) | ejection angle mean / median deg | Z (H0 = 0) | steps | "
-        "wall s (threads) |" % (bed_word, end_word),
-        "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        "wall s (threads) | schedule: raises, energy injected J |" % (bed_word, end_word),
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, (v, rep, s, o) in runs.items():
         lines.append(
             f"| {name} | {v} | {rep} | {o['collected_mg']:.1f} | "
@@ -131,7 +134,8 @@ def write(runs, docs, md, prefix, bed_word, end_word):
             f"{'–' if o['angle_mean'] is None else format(o['angle_mean'], '.1f')} / "
             f"{'–' if o['angle_median'] is None else format(o['angle_median'], '.1f')} | "
             f"{'–' if o['z'] is None else format(o['z'], '.2f')} | {o['steps']} | "
-            f"{o['wall']:.0f} ({o['threads']}) |")
+            f"{o['wall']:.0f} ({o['threads']}) | "
+            f"{'off' if o['raised'] is None else '%d, %.3g' % (o['raised'], o['injected_j'])} |")
     lines += ["", "Per speed, mean ± SD over the shots (SD from n − 1):", "",
               "| speed m/s | shots | collected mg | grains in horn | crater depth mm | crater radius mm | ejected grains | "
               "mean ejection angle deg | Z |",

@@ -281,8 +281,8 @@ def sampler():
 
     r300, r300_1s, r50, r50_1s = runs("v300"), runs("v300_1s"), runs("v50"), runs("v50_1s")
     # The first milliseconds, one shot per bed (a turned repeat is a bed of its own): the shot at the scene's
-    # stiffness where the bed has one, else the 1 s shot, whose schedule lowers k_n only once the
-    # projectile has stopped.
+    # stiffness where the bed has one, else the 1 s shot (the same shot to the digit until its schedule
+    # first lowers k_n, after 62 us on the shipped beds).
     def one_per_bed(preferred_last):
         per_bed = {}
         for d, s in preferred_last:

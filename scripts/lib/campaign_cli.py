@@ -53,6 +53,12 @@ def run_and_keep(bin_dir, config, out_dir, keep, overrides, campaign, copies=(),
     t0 = time.time()
     r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     wall = time.time() - t0
+    if r.returncode < 0:
+        # Killed by a signal from outside (the campaign interrupted): nothing is recorded, so the run is
+        # not taken as stopped and runs again next time; the campaign stops here.
+        sys.stderr.write(r.stdout[-3000:])
+        raise SystemExit("%s: killed by signal %d after %.0f s; not recorded (it runs again next time)"
+                         % (os.path.basename(keep), -r.returncode, wall))
     os.makedirs(keep, exist_ok=True)
     if r.returncode != 0:
         sys.stderr.write(r.stdout[-3000:])

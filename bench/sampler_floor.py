@@ -90,11 +90,6 @@ def validation_shot(name, bed):
     return s
 
 
-def reference(bed):
-    """The reference shot on bed k (results/sampler/shots/v300_b<k>), as validation_shot()."""
-    return validation_shot("off", bed)
-
-
 def run(names, beds, threads):
     bin_dir = os.environ.get("REGOLITH_BIN", os.path.join(ROOT, "build", "devel", "lib", "regolith_twin"))
     os.makedirs(KEEP, exist_ok=True)

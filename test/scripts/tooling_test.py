@@ -236,6 +236,23 @@ class SamplerFloorPairs(unittest.TestCase):
             self.assertIsNone(sf.at_time(os.path.join(t, "short.csv")))
 
 
+class KilledRun(unittest.TestCase):
+    """A run killed by a signal from outside is not recorded as stopped: it runs again next time."""
+
+    def test_signal_exit_not_kept(self):
+        with tempfile.TemporaryDirectory() as t:
+            sim = os.path.join(t, "regolith_sim")
+            with open(sim, "w") as f:
+                f.write("#!/bin/sh\nkill -TERM $$\n")
+            os.chmod(sim, 0o755)
+            keep = os.path.join(t, "keep", "run_s1")
+            with self.assertRaises(SystemExit) as e, contextlib.redirect_stderr(io.StringIO()):
+                campaign_cli.run_and_keep(t, "scene.yaml", os.path.join(t, "out"), keep, ["seed=1"], {})
+            self.assertIn("killed by signal 15", str(e.exception))
+            self.assertFalse(os.path.exists(keep))
+            self.assertIsNone(campaign_cli.kept(keep, "NO_SUCH_RERUN_VARIABLE"))
+
+
 class SamplerShotNames(unittest.TestCase):
     """Shots on the shipped beds are named v<speed>[_1s]_b<bed>[r<repeat>]; a turned repeat keeps its bed."""
 

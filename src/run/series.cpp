@@ -94,7 +94,8 @@ OutputFolder::~OutputFolder() {
 
 void check_writable(const std::string& path) {
   check_regular_target(path, "this output");
-  const std::string probe = temp_name(path) + ".probe";
+  // Named like every temporary file (name.tmp.PID), so that one left by a kill is recognised as such.
+  const std::string probe = temp_name(path + ".probe");
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0) throw InputError(path + ": cannot be written (" + std::strerror(errno) + ")");
   ::close(fd);

@@ -97,6 +97,8 @@ def outcome(s):
         # The stiffness schedule's raises (docs/model.md §17): how often, and the elastic energy they added.
         "raised": s["run"].get("schedule", {}).get("raised"),
         "injected_j": s["run"].get("schedule", {}).get("injected_energy"),
+        # A shot the run stopped (the schedule's bound on injected energy, a blow-up): listed, not averaged.
+        "status": s.get("status", "ok"),
     }
 
 
@@ -135,13 +137,19 @@ def write(runs, docs, md, prefix, bed_word, end_word):
             f"{'–' if o['angle_median'] is None else format(o['angle_median'], '.1f')} | "
             f"{'–' if o['z'] is None else format(o['z'], '.2f')} | {o['steps']} | "
             f"{o['wall']:.0f} ({o['threads']}) | "
-            f"{'off' if o['raised'] is None else '%d, %.3g' % (o['raised'], o['injected_j'])} |")
-    lines += ["", "Per speed, mean ± SD over the shots (SD from n − 1):", "",
+            f"{'off' if o['raised'] is None else '%d, %.3g' % (o['raised'], o['injected_j'])}"
+            f"{'' if o['status'] == 'ok' else '; **stopped (%s) at %.4g s**' % (o['status'], o['sim'] or 0)} |")
+    stopped = [n for n, r in runs.items() if r[3]["status"] != "ok"]
+    if stopped:
+        lines += ["", "Stopped before their end, listed with what they reached and left out of the means: " +
+                  ", ".join(stopped) + " (their summary.json `message` says why, e.g. the stiffness schedule's "
+                  "raises adding more energy than `schedule.max_injected` allows, docs/model.md §17)."]
+    lines += ["", "Per speed, mean ± SD over the shots that ran to their end (SD from n − 1):", "",
               "| speed m/s | shots | collected mg | grains in horn | crater depth mm | crater radius mm | ejected grains | "
               "mean ejection angle deg | Z |",
               "|---|---|---|---|---|---|---|---|---|"]
     for v in sorted({r[0] for r in runs.values()}, reverse=True):
-        os_ = [r[3] for r in runs.values() if r[0] == v]
+        os_ = [r[3] for r in runs.values() if r[0] == v and r[3]["status"] == "ok"]
 
         def col(key, digits=1):
             return fmt(*mean_sd([o[key] for o in os_], missing=None), digits=digits)

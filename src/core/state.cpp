@@ -91,4 +91,21 @@ State make_state(const Model& m) {
   return s;
 }
 
+void scale_contact_springs(State& s, double f) {
+  const auto scale = [f](auto& list) {
+    for (Vec3& v : list.spring_t) v *= f;
+    for (Vec3& v : list.spring_r) v *= f;
+    for (double& v : list.spring_w) v *= f;
+  };
+  scale(s.pairs);
+  scale(s.wall_pairs);
+  scale(s.body_grains);
+  for (MeshSlot& k : s.body_grains.mesh_slots) {
+    k.spring_t *= f;
+    k.spring_r *= f;
+    k.spring_w *= f;
+  }
+  for (BodyPointContact& c : s.body_points) c.spring_t *= f;
+}
+
 }  // namespace rt

@@ -22,12 +22,13 @@ namespace rt {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'G', 'T', 'W', 'C', 'K', 'P', 'T'};
-// 8: the fields' evolving values (a gas field's anchoring plane, docs/model.md §10);
+// 9: the stiffness schedule's reference kinetic energy and raises by cause
+// (docs/model.md §17); 8: the fields' evolving values (a gas field's anchoring plane, docs/model.md §10);
 // 7: free flight (docs/model.md §18): the grains' reaches and the body poses
 // of the last full build; 6 (ticks and the stiffness schedule's state, docs/model.md §17), 5 (sleep
 // state, docs/model.md §16), 4 (history slots of grain–mesh contacts), 3
 // (rigid bodies, no grain–mesh contacts) and 2 (grains only) are still read.
-constexpr uint32_t kVersion = 8;
+constexpr uint32_t kVersion = 9;
 
 // Fingerprint of the static grain description a state belongs to.
 uint64_t model_fingerprint(const Model& m) {
@@ -338,6 +339,8 @@ std::string checkpoint_image(const Model& m, const State& s) {
   w.pod<int64_t>(s.free_grains_max);
   w.vec(s.field_values);  // the fields' evolving values (model.md §10)
   w.vec(s.pairs.image);   // periodic boxes: the image of each pair entry's partner (model.md §11)
+  w.pod(q.kinetic_ref);   // the schedule's reference energy and raises by cause (model.md §17)
+  for (long c : {q.raised_grains, q.raised_body, q.raised_contact}) w.pod<int64_t>(c);
   const uint64_t sum = fnv1a(w.buf.data(), w.buf.size());
   w.pod(sum);
   return std::move(w.buf);
@@ -364,7 +367,7 @@ State state_from_checkpoint(const std::string& path, const std::string& data, co
   char magic[8];
   r.raw(magic, 8);
   const uint32_t version = r.pod<uint32_t>();
-  if (version != kVersion && version != 7 && version != 6 && version != 5 && version != 4 && version != 3 && version != 2)
+  if (version != kVersion && version != 8 && version != 7 && version != 6 && version != 5 && version != 4 && version != 3 && version != 2)
     r.fail("format version " + std::to_string(version) + ", this build reads version " + std::to_string(kVersion));
   const uint64_t n = r.pod<uint64_t>();
   if (n != uint64_t(m.n_grains))
@@ -500,6 +503,16 @@ State state_from_checkpoint(const std::string& path, const std::string& data, co
     for (double v : s.field_values)
       if (!std::isfinite(v)) r.fail("a field value is not finite");
     r.vec(s.pairs.image);
+  }
+  if (version >= 9) {
+    ScheduleState& q = s.schedule;
+    q.kinetic_ref = r.pod<double>();
+    q.raised_grains = r.pod<int64_t>();
+    q.raised_body = r.pod<int64_t>();
+    q.raised_contact = r.pod<int64_t>();
+    if (!(q.kinetic_ref >= 0) || !std::isfinite(q.kinetic_ref) || q.raised_grains < 0 || q.raised_body < 0 ||
+        q.raised_contact < 0 || q.raised_grains + q.raised_body + q.raised_contact > q.raised)
+      r.fail("stiffness schedule state is invalid");
   }
   if (s.pairs.image.size() != (m.periodic.any() ? s.pairs.partner.size() : 0))
     r.fail(m.periodic.any() ? "the pair list's periodic images do not match its entries (or the file was written "

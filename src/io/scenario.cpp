@@ -758,7 +758,7 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
 
   // Stiffness schedule (docs/model.md §17).
   const YAML::Node sh = rd.map(root, "", "schedule", false);
-  rd.only(sh, "schedule", {"enabled", "speed", "margin", "floor", "after", "check_every"});
+  rd.only(sh, "schedule", {"enabled", "speed", "margin", "floor", "after", "check_every", "max_injected"});
   ScheduleParams& q = m.schedule;
   q.enabled = rd.boolean(sh, "schedule", "enabled", false);
   q.speed = rd.number(sh, "schedule", "speed", derived.design_speed > 0 ? derived.design_speed : sc.v_ref, 0, 1e5,
@@ -767,6 +767,7 @@ Scenario interpret_scenario(const YAML::Node& root, const std::string& source, c
   q.floor = rd.number(sh, "schedule", "floor", q.floor, 1e-8, 1);
   q.after = rd.number(sh, "schedule", "after", q.after, 0, kMaxSceneDuration);
   q.check_every = int(rd.integer(sh, "schedule", "check_every", q.check_every, 1, 1000000));
+  q.max_injected = rd.number(sh, "schedule", "max_injected", q.max_injected, 0, 1e6);
 
   // Free flight (docs/model.md §18).
   const YAML::Node ff = rd.map(root, "", "free_flight", false);

@@ -105,6 +105,10 @@ void add_schedule_summary(JsonObject& j, const RunReport& rep) {
   o.num("kn_factor_at_end", q.scale).num("kn_factor_min", q.min_scale);
   o.num("lowered", double(q.lowered)).num("raised", double(q.raised));
   o.num("injected_energy", q.injected).num("released_energy", q.released).num("max_injected_fraction_of_kinetic", q.max_injected_fraction);
+  o.num("kinetic_energy_ref", q.kinetic_ref);
+  JsonObject by;
+  by.num("grains", double(q.raised_grains)).num("body", double(q.raised_body)).num("loaded_contact", double(q.raised_contact));
+  o.obj("raised_by", by);
   j.obj("schedule", o);
 }
 

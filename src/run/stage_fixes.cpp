@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <sstream>
 
 #include "regolith_twin/core/edit.hpp"
 #include "regolith_twin/core/energy.hpp"
@@ -186,6 +187,9 @@ void StiffnessSchedule::start(Model& m, State& s) {
   on_ = m.schedule.enabled;
   if (!on_) return;
   if (!(m.schedule.speed > 0)) throw InputError("schedule.speed: the design speed must be > 0 m/s");
+  if (m.contact_model != ContactModel::Linear)
+    throw InputError("schedule.enabled: the stiffness schedule scales the linear law's k_n; "
+                     "contact.model hertz_mindlin has no k_n to scale");
   for (const Stage& st : plan_.stages)
     if (st.stiffness_scale > 0)
       throw InputError("stage '" + st.name + "' sets a stiffness scale and the stiffness schedule "
@@ -205,6 +209,7 @@ void StiffnessSchedule::start(Model& m, State& s) {
     q.started = true;
     q.t_start = s.time;
     q.dt_min = q.dt_max = m.dt;
+    q.kinetic_ref = energy(m, s).kinetic();
     check(m, s, true);
   } else if (q.scale != 1.0) {  // a resumed state runs on at the factor it was saved with
     set_scale(m, s, q.scale, false);
@@ -231,6 +236,11 @@ std::string StiffnessSchedule::progress(const Model& m, const State&) const {
 
 void StiffnessSchedule::set_scale(Model& m, State& s, double scale, bool account) {
   ScheduleState& q = s.schedule;
+  // A raise shortens every stored spring (tangential, rolling, twisting) by
+  // the ratio of the factors, so that their forces stay what they were and
+  // their energy falls by that ratio: only the overlaps, which cannot be
+  // changed, take on energy.
+  if (account && scale > q.scale) scale_contact_springs(s, q.scale / scale);
   const double el_old = account ? energy(m, s).elastic : 0.0;
   m.kn = kn0_ * scale;
   if (body_kn0_ > 0) m.body_kn = body_kn0_ * scale;
@@ -242,10 +252,24 @@ void StiffnessSchedule::set_scale(Model& m, State& s, double scale, bool account
     // changes with k_n (Σ ½ Δk x² and the spring terms that scale with it).
     const Energy e = energy(m, s);
     const double d = e.elastic - el_old, kin = e.kinetic();
+    q.kinetic_ref = std::max(q.kinetic_ref, kin);
     if (scale > q.scale) {
       ++q.raised;
       q.injected += d;
       q.max_injected_fraction = std::max(q.max_injected_fraction, kin > 0 ? d / kin : (d > 0 ? INFINITY : 0.0));
+      const double limit = m.schedule.max_injected * q.kinetic_ref;
+      if (m.schedule.max_injected > 0 && q.injected > limit) {
+        std::ostringstream os;
+        os << "t = " << s.time << " s: the stiffness schedule's raises of k_n have added " << q.injected
+           << " J to live contacts (" << q.raised << " raises; this one " << d << " J, to " << scale
+           << " of the scene's k_n, set by " << why_ << " at v_fast " << vfast_ << " m/s), more than "
+           << "schedule.max_injected " << m.schedule.max_injected << " x the largest kinetic energy seen, "
+           << q.kinetic_ref << " J: the run would go on with energy the scene does not have. "
+           << "Raise schedule.floor (smaller and fewer raises), turn the schedule off, or set "
+           << "schedule.max_injected (0: off)";
+        q.scale = scale;
+        throw BlowUpError(os.str());
+      }
     } else {
       ++q.lowered;
       q.released -= d;
@@ -299,6 +323,7 @@ void StiffnessSchedule::check(Model& m, State& s, bool grains_now) {
   // Twice the target on either change.
   if (t > q.scale) {
     q.low_since = -1;
+    ++(vfast_ == v_overlap ? q.raised_contact : vfast_ == v_body ? q.raised_body : q.raised_grains);
     set_scale(m, s, std::min(1.0, 2 * t), true);
   } else if (t < 0.25 * q.scale && s.time - q.t_start >= p.after) {
     if (q.low_since < 0) q.low_since = s.step;

@@ -1,7 +1,9 @@
 // Stiffness schedule (docs/model.md §17): a bouncing grain keeps the
 // restitution of the linear law (independent of k_n) while k_n and Δt follow
 // its speed, in fewer steps; a fast grain appearing raises k_n at once and
-// the energy this injects into a resting contact is ½ Δk x²; a run resumed
+// the energy this injects into a resting contact is ½ Δk x², the raise
+// shortens the stored springs so that their forces stay the same, and a
+// bound on the injected energy stops the run with a diagnostic; a run resumed
 // from a checkpoint under a lowered k_n continues bit for bit; observers
 // sampling every N steps keep their period in simulated time.
 #include <gtest/gtest.h>
@@ -182,6 +184,130 @@ schedule: {enabled: true, floor: 1.0e-3}
   // Grain 1 hits grain 0 at about 4 m/s: resolved at the scene's stiffness,
   // the overlap stays near the design 1 % of the radius.
   EXPECT_LT(rep.max_overlap_ratio, 0.02);
+}
+
+namespace {
+
+// A grain resting on the floor under gravity tilted by atan(0.1), held by
+// friction and rolling resistance (the moderate preset: mu_s 1, mu_R beta
+// 0.21 > 0.1), so its wall contact stores a tangential and a rolling
+// spring; grain 1 is thrown down at the design speed at t = 0.1 s.
+std::string loaded_throw_yaml(const std::string& schedule) {
+  return R"(
+name: throw
+gravity: [0.981, 0, -9.81]
+materials:
+  grain: {preset: moderate}
+  wall: {preset: moderate, structure: true}
+contact: {model: linear, kn: rule, v_max: 4.0, x_max: 0.01, steps_per_contact: 30}
+walls:
+  - {type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: wall}
+grains:
+  - {name: rest, material: grain, radius: 0.01, position: [0, 0, 0.01]}
+  - {name: fly, material: grain, radius: 0.01, position: [0, 0, 0.08]}
+stages:
+  - {name: wait, duration: 0.1, hold: [fly]}
+  - {name: go, duration: 0.03}
+schedule: )" + schedule + "\n";
+}
+
+// The springs of grain 0's wall contact at the end of the last step before
+// the raise (the schedule checks the grains' speeds every 10 steps) and just
+// after the raise, at the end of the step that made it (this fix's end_step
+// comes after the schedule's).
+class SpringsAcrossTheRaise : public Throw {
+ public:
+  using Throw::Throw;
+  void end_step(rt::Model& m, rt::State& s, bool) override {
+    if (!thrown || taken_after) return;
+    const bool after = kn_at > 0 && m.kn != kn_at;
+    for (int e = 0; e < s.wall_pairs.size(); ++e)
+      if (s.wall_pairs.grain[e] == 0 && s.wall_pairs.touching[e]) {
+        (after ? t_after : t_before) = s.wall_pairs.spring_t[e];
+        (after ? r_after : r_before) = s.wall_pairs.spring_r[e];
+        (after ? kn_after : kn_at) = m.kn;
+      }
+    taken_after = after;
+  }
+  rt::Vec3 t_before = rt::Vec3::Zero(), t_after = rt::Vec3::Zero();
+  rt::Vec3 r_before = rt::Vec3::Zero(), r_after = rt::Vec3::Zero();
+  double kn_at = 0, kn_after = 0;
+  bool taken_after = false;
+};
+
+}  // namespace
+
+TEST(Schedule, ARaiseKeepsTheSpringForcesOfLiveContacts) {
+  rt::Scenario sc = rt::parse_scenario_text(loaded_throw_yaml("{enabled: true, floor: 1.0e-3}"));
+  const double kn_scene = sc.model.kn;
+  rt::State s = sc.initial;
+  SpringsAcrossTheRaise t(0.1);
+  rt::Run run(sc.model, s, rt::RunPlan::of(sc), quiet());
+  run.add_fix(&t);
+  const rt::RunReport rep = run.run();
+  ASSERT_EQ(rep.status, "ok") << rep.message;
+  ASSERT_TRUE(t.taken_after);
+  EXPECT_EQ(s.schedule.raised, 1);
+  EXPECT_EQ(s.schedule.raised_grains, 1) << "set by the thrown grain";
+  ASSERT_EQ(t.kn_at, 1.0e-3 * kn_scene);
+  ASSERT_EQ(t.kn_after, kn_scene);
+  // The tangential spring holds the tilt (k_t S = 0.1 m g) and the rolling
+  // spring the moment; a thousandfold stiffness shortens both a thousandfold,
+  // so their forces stay the same. One step lies between the two readings,
+  // in which the grain still creeps under the soft k_n (the springs move by
+  // under 1 % in a step); springs kept as they were would read 1000 here.
+  ASSERT_GT(t.t_before.norm(), 0.0);
+  ASSERT_GT(t.r_before.norm(), 0.0);
+  const double ratio = t.kn_at / t.kn_after;
+  RecordProperty("spring_t_before_m", rt::test::figure(t.t_before.norm()));
+  RecordProperty("spring_t_after_m", rt::test::figure(t.t_after.norm()));
+  EXPECT_NEAR(t.t_after.norm() / (ratio * t.t_before.norm()), 1.0, 0.01);
+  EXPECT_NEAR(t.r_after.norm() / (ratio * t.r_before.norm()), 1.0, 0.01);
+}
+
+TEST(Schedule, TooMuchInjectedEnergyStopsTheRun) {
+  // The raise puts ½ (k1 - k0) x² into grain 0's overlap, x = m g / k0: about
+  // 0.4 % of the thrown grain's kinetic energy. A bound of 0.1 % stops the
+  // run at that raise; the default 5 % does not.
+  for (const double bound : {1.0e-3, 0.0}) {
+    rt::Scenario sc = rt::parse_scenario_text(loaded_throw_yaml(
+        bound > 0 ? "{enabled: true, floor: 1.0e-3, max_injected: 1.0e-3}" : "{enabled: true, floor: 1.0e-3}"));
+    rt::State s = sc.initial;
+    Throw t(0.1);
+    rt::Run run(sc.model, s, rt::RunPlan::of(sc), quiet());
+    run.add_fix(&t);
+    const rt::RunReport rep = run.run();
+    const rt::ScheduleState& q = s.schedule;
+    const double thrown_ke = 0.5 * sc.model.grain_mass[1] * 16.0;
+    EXPECT_NEAR(q.kinetic_ref / thrown_ke, 1.0, 0.01) << "the reference is the thrown grain's energy";
+    EXPECT_GT(q.injected / q.kinetic_ref, 2e-3);
+    EXPECT_LT(q.injected / q.kinetic_ref, 6e-3);
+    if (bound > 0) {
+      EXPECT_EQ(rep.status, "blow_up");
+      EXPECT_NE(rep.message.find("schedule.max_injected"), std::string::npos) << rep.message;
+      EXPECT_NE(rep.message.find("grains"), std::string::npos) << "names what set v_fast: " << rep.message;
+      EXPECT_NEAR(s.time, 0.1, 1e-3) << "stopped at the raise";
+    } else {
+      EXPECT_EQ(rep.status, "ok") << rep.message;
+    }
+  }
+}
+
+TEST(Schedule, TheHertzMindlinLawIsRefused) {
+  // The schedule scales k_n and Δt together; the Hertz–Mindlin law has no k_n.
+  std::string yaml = loaded_throw_yaml("{enabled: true}");
+  const std::string linear = "contact: {model: linear, kn: rule, v_max: 4.0, x_max: 0.01, steps_per_contact: 30}";
+  yaml.replace(yaml.find(linear), linear.size(), "contact: {model: hertz_mindlin, dt: 1.0e-6}");
+  yaml.replace(yaml.find("grain: {preset: moderate}"), 25, "grain: {preset: moderate, young: 1.0e8}");
+  rt::Scenario sc = rt::parse_scenario_text(yaml);
+  rt::State s = sc.initial;
+  try {
+    rt::Run run(sc.model, s, rt::RunPlan::of(sc), quiet());
+    run.run();
+    ADD_FAILURE() << "a Hertz-Mindlin scene with the schedule ran";
+  } catch (const rt::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("hertz_mindlin"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Schedule, ResumeUnderALoweredStiffnessIsBitIdentical) {

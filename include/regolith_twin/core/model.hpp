@@ -137,8 +137,9 @@ struct FreeFlightParams {
 // and Δt = Δt_scene / sqrt(k_n / k_scene) (the same steps per contact).
 // v_fast also counts the speed stored in the deepest contact, so a contact
 // being compressed keeps k_n up. k_n is set to twice the target when the
-// target passes it (raised at once: the energy this injects into live
-// contacts is measured and reported), or when the target has stayed below a
+// target passes it (raised at once: the live contacts' springs are shortened
+// so that their forces stay the same, and the energy the raise injects into
+// their overlaps is measured, reported and bounded by max_injected), or when the target has stayed below a
 // quarter of it for three durations of the longest contact (lowered: the
 // energy taken out of live contacts is reported too).
 struct ScheduleParams {
@@ -148,6 +149,9 @@ struct ScheduleParams {
   double floor = 1e-4;     // smallest factor on the scene's k_n (Δt at most 100x the scene's)
   double after = 0;        // s of simulated time from the run's start before the first lowering
   int check_every = 10;    // steps between checks of the grains' speeds (bodies: every step)
+  // The run stops with a diagnostic once the raises have added more than this
+  // fraction of the largest kinetic energy seen (ScheduleState::kinetic_ref); 0: off.
+  double max_injected = 0.05;
 };
 
 struct Guards {

@@ -185,6 +185,8 @@ struct ScheduleState {
   double injected = 0;           // elastic energy added to live contacts by raising k_n, J
   double released = 0;           // elastic energy taken from live contacts by lowering k_n, J
   double max_injected_fraction = 0;  // largest injection relative to the kinetic energy then
+  double kinetic_ref = 0;        // largest kinetic energy seen at the start and at every change, J
+  long raised_grains = 0, raised_body = 0, raised_contact = 0;  // raises by what set v_fast
   bool started = false;          // the schedule has run (its base is the scene's k_n and Δt)
   double t_start = 0;            // simulated time it started, s
   double v_grains = 0;           // fastest grain at the last check, m/s
@@ -284,6 +286,12 @@ inline bool ticks_crossed(const State& s, long every, double origin = 0) {
 
 // Sleeping is on and its state initialised (core/sleep.hpp).
 inline bool sleep_active(const Model& m, const State& s) { return m.sleep.enabled && s.sleep.initialized; }
+
+// Multiplies every stored contact spring (tangential, rolling, twisting; grain
+// pairs, grain–wall, grain–body with their mesh slots, body–body points) by f.
+// With every spring stiffness scaled by 1/f at the same time, the springs'
+// forces are unchanged (the stiffness schedule's raise, docs/model.md §17).
+void scale_contact_springs(State& s, double f);
 
 // A state for model m: zero kinematics (callers set pos, vel, omega), every
 // buffer sized, lists built at the first step.

@@ -299,15 +299,23 @@ void StiffnessSchedule::check(Model& m, State& s, bool grains_now) {
   for (size_t b = 0; b < s.bodies.size(); ++b)
     vb = std::max(vb, s.bodies[b].vel.norm() + s.bodies[b].omega.norm() * m.bodies[b].bound_radius);
   // Fastest possible approach: two grains head-on, or a grain and a body point.
-  // Speed stored in the deepest contact of the last force pass: a contact at
-  // overlap x holds the energy of an approach at x sqrt(k_n / m*), bounded with
-  // the smallest grain (m* >= m_min / 2).
   if (grains_now || !(m_min_ > 0)) {
     m_min_ = std::numeric_limits<double>::infinity();
     for (int i = 0; i < m.n_grains; ++i) m_min_ = std::min(m_min_, m.grain_mass[i]);
   }
-  const double v_overlap =
-      m.n_grains > 0 ? s.stats.max_overlap_ratio * m.min_radius * std::sqrt(2 * m.kn / m_min_) : 0.0;
+  // The deepest contact of the last force pass, as the factor that brings its
+  // overlap to the design overlap: the scene's k_n takes the smallest grains
+  // head-on at the design speed to x_d = speed sqrt(m_min / (2 k_scene)), so a
+  // contact at overlap ratio rho (of the pair's smaller radius, compared as
+  // rho r_min) under factor f asks for f rho r_min / x_d. An overlap held by a
+  // load grows as 1/f when k_n is lowered, so what it asks for does not change
+  // with f (no raise follows a lowering); a collision's grows as 1/sqrt(f), so
+  // the rule is on the safe side for it. Expressed as the speed whose target
+  // it is (v_fast, the progress line and the diagnostics).
+  const double x_d = p.speed * std::sqrt(m_min_ / (2 * kn0_));
+  const double t_overlap =
+      m.n_grains > 0 && x_d > 0 ? p.margin * q.scale * s.stats.max_overlap_ratio * m.min_radius / x_d : 0.0;
+  const double v_overlap = p.speed * std::sqrt(t_overlap) / p.margin;
   // Raised at once for anything faster. Lowered only once the target has
   // stayed below a quarter of the current factor for three durations of the
   // longest contact: lowering k_n takes ½ Δk x² out of every live contact, so

@@ -139,15 +139,22 @@ class Throw : public rt::Fix {
 
 }  // namespace
 
-TEST(Schedule, AFastGrainRaisesStiffnessAndTheInjectionIsMeasured) {
-  // Grain 0 rests on the floor; grain 1 is held 5 cm above it until thrown
-  // down at 4 m/s (the design speed): both slow before, so k_n sits at the floor.
-  const std::string yaml = R"(
+namespace {
+
+// Grain 0 rests on the floor; grain 1 is held 5 cm above it until thrown
+// down at 4 m/s (the design speed) at t = 0.1 s: both slow before, so k_n
+// sits at the floor. Frictionless, or (loaded) under gravity tilted by
+// atan(0.1) and held by friction and rolling resistance (the moderate
+// preset: mu_s 1, mu_R beta 0.21 > 0.1), so that grain 0's wall contact
+// stores a tangential and a rolling spring.
+std::string throw_yaml(bool loaded, const std::string& schedule) {
+  return std::string(R"(
 name: throw
-gravity: [0, 0, -9.81]
+gravity: )") + (loaded ? "[0.981, 0, -9.81]" : "[0, 0, -9.81]") + R"(
 materials:
-  grain: {preset: moderate, eps_n: 0.5, eps_t: 1.0, mu_s: 0.0}
-  wall: {preset: moderate, eps_n: 0.5, eps_t: 1.0, mu_s: 0.0, structure: true}
+)" + (loaded ? "  grain: {preset: moderate}\n  wall: {preset: moderate, structure: true}\n"
+             : "  grain: {preset: moderate, eps_n: 0.5, eps_t: 1.0, mu_s: 0.0}\n"
+               "  wall: {preset: moderate, eps_n: 0.5, eps_t: 1.0, mu_s: 0.0, structure: true}\n") + R"(
 contact: {model: linear, kn: rule, v_max: 4.0, x_max: 0.01, steps_per_contact: 30}
 walls:
   - {type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: wall}
@@ -157,15 +164,26 @@ grains:
 stages:
   - {name: wait, duration: 0.1, hold: [fly]}
   - {name: go, duration: 0.03}
-schedule: {enabled: true, floor: 1.0e-3}
-)";
-  rt::Scenario sc = rt::parse_scenario_text(yaml);
-  const double kn_scene = sc.model.kn;
-  rt::State s = sc.initial;
-  Throw t(0.1);
-  rt::Run run(sc.model, s, rt::RunPlan::of(sc), quiet());
+schedule: )" + schedule + "\n";
+}
+
+// The throw's run with fix t; the state is left in s.
+rt::RunReport run_throw(const rt::Scenario& sc, rt::State& s, Throw& t) {
+  s = sc.initial;
+  rt::Model m = sc.model;
+  rt::Run run(m, s, rt::RunPlan::of(sc), quiet());
   run.add_fix(&t);
-  const rt::RunReport rep = run.run();
+  return run.run();
+}
+
+}  // namespace
+
+TEST(Schedule, AFastGrainRaisesStiffnessAndTheInjectionIsMeasured) {
+  rt::Scenario sc = rt::parse_scenario_text(throw_yaml(false, "{enabled: true, floor: 1.0e-3}"));
+  const double kn_scene = sc.model.kn;
+  rt::State s;
+  Throw t(0.1);
+  const rt::RunReport rep = run_throw(sc, s, t);
   ASSERT_EQ(rep.status, "ok") << rep.message;
   ASSERT_TRUE(t.thrown);
   const rt::ScheduleState& q = s.schedule;
@@ -187,29 +205,6 @@ schedule: {enabled: true, floor: 1.0e-3}
 }
 
 namespace {
-
-// A grain resting on the floor under gravity tilted by atan(0.1), held by
-// friction and rolling resistance (the moderate preset: mu_s 1, mu_R beta
-// 0.21 > 0.1), so its wall contact stores a tangential and a rolling
-// spring; grain 1 is thrown down at the design speed at t = 0.1 s.
-std::string loaded_throw_yaml(const std::string& schedule) {
-  return R"(
-name: throw
-gravity: [0.981, 0, -9.81]
-materials:
-  grain: {preset: moderate}
-  wall: {preset: moderate, structure: true}
-contact: {model: linear, kn: rule, v_max: 4.0, x_max: 0.01, steps_per_contact: 30}
-walls:
-  - {type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: wall}
-grains:
-  - {name: rest, material: grain, radius: 0.01, position: [0, 0, 0.01]}
-  - {name: fly, material: grain, radius: 0.01, position: [0, 0, 0.08]}
-stages:
-  - {name: wait, duration: 0.1, hold: [fly]}
-  - {name: go, duration: 0.03}
-schedule: )" + schedule + "\n";
-}
 
 // The springs of grain 0's wall contact at the end of the last step before
 // the raise (the schedule checks the grains' speeds every 10 steps) and just
@@ -238,13 +233,11 @@ class SpringsAcrossTheRaise : public Throw {
 }  // namespace
 
 TEST(Schedule, ARaiseKeepsTheSpringForcesOfLiveContacts) {
-  rt::Scenario sc = rt::parse_scenario_text(loaded_throw_yaml("{enabled: true, floor: 1.0e-3}"));
+  rt::Scenario sc = rt::parse_scenario_text(throw_yaml(true, "{enabled: true, floor: 1.0e-3}"));
   const double kn_scene = sc.model.kn;
-  rt::State s = sc.initial;
+  rt::State s;
   SpringsAcrossTheRaise t(0.1);
-  rt::Run run(sc.model, s, rt::RunPlan::of(sc), quiet());
-  run.add_fix(&t);
-  const rt::RunReport rep = run.run();
+  const rt::RunReport rep = run_throw(sc, s, t);
   ASSERT_EQ(rep.status, "ok") << rep.message;
   ASSERT_TRUE(t.taken_after);
   EXPECT_EQ(s.schedule.raised, 1);
@@ -270,13 +263,11 @@ TEST(Schedule, TooMuchInjectedEnergyStopsTheRun) {
   // 0.4 % of the thrown grain's kinetic energy. A bound of 0.1 % stops the
   // run at that raise; the default 5 % does not.
   for (const double bound : {1.0e-3, 0.0}) {
-    rt::Scenario sc = rt::parse_scenario_text(loaded_throw_yaml(
-        bound > 0 ? "{enabled: true, floor: 1.0e-3, max_injected: 1.0e-3}" : "{enabled: true, floor: 1.0e-3}"));
-    rt::State s = sc.initial;
+    rt::Scenario sc = rt::parse_scenario_text(throw_yaml(
+        true, bound > 0 ? "{enabled: true, floor: 1.0e-3, max_injected: 1.0e-3}" : "{enabled: true, floor: 1.0e-3}"));
+    rt::State s;
     Throw t(0.1);
-    rt::Run run(sc.model, s, rt::RunPlan::of(sc), quiet());
-    run.add_fix(&t);
-    const rt::RunReport rep = run.run();
+    const rt::RunReport rep = run_throw(sc, s, t);
     const rt::ScheduleState& q = s.schedule;
     const double thrown_ke = 0.5 * sc.model.grain_mass[1] * 16.0;
     EXPECT_NEAR(q.kinetic_ref / thrown_ke, 1.0, 0.01) << "the reference is the thrown grain's energy";
@@ -293,9 +284,53 @@ TEST(Schedule, TooMuchInjectedEnergyStopsTheRun) {
   }
 }
 
+TEST(Schedule, ALoadedContactAsksForTheSameFactorAtAnyStiffness) {
+  // One grain (1 cm) resting on the floor under g = 1000 m/s²: its overlap
+  // m g / (f k_scene) is held by the load, so it grows as k_n is lowered. The
+  // design overlap of the scene (4 m/s, 1 %) is x_d = 4 sqrt(m / (2 k_scene))
+  // with k_scene = m (4 / 1e-4)^2, and the contact asks for the factor
+  // 1.2 f x / x_d = 1.2 g / (1.6e9 x_d) = 0.0106 at any f: the schedule comes
+  // down to about twice that and stays, without a raise. (A rule that read
+  // the overlap as a speed, x sqrt(2 k_n / m), asks for 1.1e-4 / f: lowered
+  // from 1 to 2.2e-4, it would ask for 0.5 and raise again, and so on.)
+  const std::string yaml = R"(
+name: loaded
+gravity: [0, 0, -1000]
+materials:
+  grain: {preset: moderate, eps_n: 0.5, eps_t: 1.0, mu_s: 0.0}
+  wall: {preset: moderate, eps_n: 0.5, eps_t: 1.0, mu_s: 0.0, structure: true}
+contact: {model: linear, kn: rule, v_max: 4.0, x_max: 0.01, steps_per_contact: 30}
+walls:
+  - {type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: wall}
+grains:
+  - {name: rest, material: grain, radius: 0.01, position: [0, 0, 0.01]}
+stages:
+  - {name: rest, duration: 0.5}
+schedule: {enabled: true}
+)";
+  rt::Scenario sc = rt::parse_scenario_text(yaml);
+  const double k0 = sc.model.kn, m0 = sc.model.grain_mass[0];
+  rt::State s = sc.initial;
+  rt::Run run(sc.model, s, rt::RunPlan::of(sc), quiet());
+  const rt::RunReport rep = run.run();
+  ASSERT_EQ(rep.status, "ok") << rep.message;
+  const rt::ScheduleState& q = s.schedule;
+  const double x_d = 4.0 * std::sqrt(m0 / (2 * k0)), asked = 1.2 * m0 * 1000.0 / (k0 * x_d);
+  RecordProperty("factor_asked", rt::test::figure(asked));
+  RecordProperty("factor_at_end", rt::test::figure(q.scale));
+  EXPECT_NEAR(asked, 0.0106, 0.0002);
+  EXPECT_EQ(q.raised, 0);
+  EXPECT_GE(q.lowered, 1);
+  // Lowered to twice what the contact asked for at the last lowering (the
+  // overlap still rings from the drop: up to some 10 % over the static one),
+  // and not again while the factor stays under four times what it asks for.
+  EXPECT_GE(q.scale, 1.9 * asked);
+  EXPECT_LT(q.scale, 4 * asked);
+}
+
 TEST(Schedule, TheHertzMindlinLawIsRefused) {
   // The schedule scales k_n and Δt together; the Hertz–Mindlin law has no k_n.
-  std::string yaml = loaded_throw_yaml("{enabled: true}");
+  std::string yaml = throw_yaml(true, "{enabled: true}");
   const std::string linear = "contact: {model: linear, kn: rule, v_max: 4.0, x_max: 0.01, steps_per_contact: 30}";
   yaml.replace(yaml.find(linear), linear.size(), "contact: {model: hertz_mindlin, dt: 1.0e-6}");
   yaml.replace(yaml.find("grain: {preset: moderate}"), 25, "grain: {preset: moderate, young: 1.0e8}");

@@ -135,8 +135,9 @@ struct FreeFlightParams {
 // fastest grain, or the fastest body point plus the fastest grain), by the
 // same rule: target = (margin v_fast / speed)^2 in [floor, 1] of k_scene,
 // and Δt = Δt_scene / sqrt(k_n / k_scene) (the same steps per contact).
-// v_fast also counts the speed stored in the deepest contact, so a contact
-// being compressed keeps k_n up. k_n is set to twice the target when the
+// The deepest contact asks for the factor that brings its overlap to the
+// design overlap (linear in the overlap: a load's overlap does not call for a
+// raise after a lowering), so a contact being compressed keeps k_n up. k_n is set to twice the target when the
 // target passes it (raised at once: the live contacts' springs are shortened
 // so that their forces stay the same, and the energy the raise injects into
 // their overlaps is measured, reported and bounded by max_injected), or when the target has stayed below a

@@ -4,8 +4,18 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BUILD=${REGOLITH_BUILD:-$ROOT/build}
 # REGOLITH_BIN=DIR: run the tools in DIR (a copy of the binaries, so that a long campaign is not
-# changed by a rebuild under it) and build nothing.
+# changed by a rebuild under it: scripts/copy_binaries DIR) and build nothing. The tools find the
+# project's libraries through their run path in the build folder unless DIR holds its own copies,
+# which are then put first on LD_LIBRARY_PATH.
 BIN=${REGOLITH_BIN:-$BUILD/devel/lib/regolith_twin}
+if [ -n "${REGOLITH_BIN:-}" ]; then
+  if compgen -G "$REGOLITH_BIN/libregolith_*.so" >/dev/null; then
+    export LD_LIBRARY_PATH=$REGOLITH_BIN${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+  else
+    echo "regolith_twin: $REGOLITH_BIN holds no libregolith_*.so: its tools load the build's libraries," \
+      "which a rebuild changes (scripts/copy_binaries DIR copies both)" >&2
+  fi
+fi
 # ROS and catkin tools run with the system interpreter, not a pyenv one.
 export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
 # Waiting OpenMP threads sleep instead of spinning: spinning threads starve

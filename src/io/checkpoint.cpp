@@ -340,7 +340,7 @@ std::string checkpoint_image(const Model& m, const State& s) {
   w.vec(s.field_values);  // the fields' evolving values (model.md §10)
   w.vec(s.pairs.image);   // periodic boxes: the image of each pair entry's partner (model.md §11)
   w.pod(q.kinetic_ref);   // the schedule's reference energy and raises by cause (model.md §17)
-  for (long c : {q.raised_grains, q.raised_body, q.raised_contact}) w.pod<int64_t>(c);
+  for (long c : {q.raised_grains, q.raised_body}) w.pod<int64_t>(c);
   const uint64_t sum = fnv1a(w.buf.data(), w.buf.size());
   w.pod(sum);
   return std::move(w.buf);
@@ -509,9 +509,8 @@ State state_from_checkpoint(const std::string& path, const std::string& data, co
     q.kinetic_ref = r.pod<double>();
     q.raised_grains = r.pod<int64_t>();
     q.raised_body = r.pod<int64_t>();
-    q.raised_contact = r.pod<int64_t>();
     if (!(q.kinetic_ref >= 0) || !std::isfinite(q.kinetic_ref) || q.raised_grains < 0 || q.raised_body < 0 ||
-        q.raised_contact < 0 || q.raised_grains + q.raised_body + q.raised_contact > q.raised)
+        q.raised_grains + q.raised_body > q.raised)
       r.fail("stiffness schedule state is invalid");
   }
   if (s.pairs.image.size() != (m.periodic.any() ? s.pairs.partner.size() : 0))

@@ -107,7 +107,7 @@ void add_schedule_summary(JsonObject& j, const RunReport& rep) {
   o.num("injected_energy", q.injected).num("released_energy", q.released).num("max_injected_fraction_of_kinetic", q.max_injected_fraction);
   o.num("kinetic_energy_ref", q.kinetic_ref);
   JsonObject by;
-  by.num("grains", double(q.raised_grains)).num("body", double(q.raised_body)).num("loaded_contact", double(q.raised_contact));
+  by.num("grains", double(q.raised_grains)).num("body", double(q.raised_body));
   o.obj("raised_by", by);
   j.obj("schedule", o);
 }

@@ -324,15 +324,22 @@ void StiffnessSchedule::check(Model& m, State& s, bool grains_now) {
     const double r = p.margin * v_fast / p.speed;
     return std::clamp(r * r, p.floor, 1.0);
   };
+  // Only speeds raise k_n: what the deepest contact asks for holds k_n up
+  // (no lowering below it) but does not raise it. A raise puts ½ Δk x² into
+  // every loaded contact, and the demand of a bed's deepest contact swings by
+  // more than the factor of 2 between a lowering and the next raise.
   const double v_grains = 2 * q.v_grains, v_body = vb + q.v_grains;
-  vfast_ = std::max({v_grains, v_body, v_overlap});
+  const double v_moving = std::max(v_grains, v_body);
+  vfast_ = std::max(v_moving, v_overlap);
   why_ = vfast_ == v_overlap ? "a loaded contact" : vfast_ == v_body ? "a body" : "grains";
-  const double t = target(vfast_);
+  const double t_raise = target(v_moving), t = target(vfast_);
   // Twice the target on either change.
-  if (t > q.scale) {
+  if (t_raise > q.scale) {
     q.low_since = -1;
-    ++(vfast_ == v_overlap ? q.raised_contact : vfast_ == v_body ? q.raised_body : q.raised_grains);
-    set_scale(m, s, std::min(1.0, 2 * t), true);
+    ++(v_moving == v_body ? q.raised_body : q.raised_grains);
+    vfast_ = v_moving;  // what the diagnostics name
+    why_ = v_moving == v_body ? "a body" : "grains";
+    set_scale(m, s, std::min(1.0, 2 * t_raise), true);
   } else if (t < 0.25 * q.scale && s.time - q.t_start >= p.after) {
     if (q.low_since < 0) q.low_since = s.step;
     if (s.step - q.low_since >= hold_) {

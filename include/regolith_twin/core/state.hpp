@@ -186,7 +186,7 @@ struct ScheduleState {
   double released = 0;           // elastic energy taken from live contacts by lowering k_n, J
   double max_injected_fraction = 0;  // largest injection relative to the kinetic energy then
   double kinetic_ref = 0;        // largest kinetic energy seen at the start and at every change, J
-  long raised_grains = 0, raised_body = 0, raised_contact = 0;  // raises by what set v_fast
+  long raised_grains = 0, raised_body = 0;  // raises by what set v_fast: the fastest grain, a body
   bool started = false;          // the schedule has run (its base is the scene's k_n and Δt)
   double t_start = 0;            // simulated time it started, s
   double v_grains = 0;           // fastest grain at the last check, m/s

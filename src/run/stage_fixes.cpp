@@ -309,8 +309,8 @@ void StiffnessSchedule::check(Model& m, State& s, bool grains_now) {
   // contact at overlap ratio rho (of the pair's smaller radius, compared as
   // rho r_min) under factor f asks for f rho r_min / x_d. An overlap held by a
   // load grows as 1/f when k_n is lowered, so what it asks for does not change
-  // with f (no raise follows a lowering); a collision's grows as 1/sqrt(f), so
-  // the rule is on the safe side for it. Expressed as the speed whose target
+  // with f; a collision's grows as 1/sqrt(f), so the rule is on the safe side
+  // for it. Expressed as the speed whose target
   // it is (v_fast, the progress line and the diagnostics).
   const double x_d = p.speed * std::sqrt(m_min_ / (2 * kn0_));
   const double t_overlap =

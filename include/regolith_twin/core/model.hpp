@@ -136,13 +136,13 @@ struct FreeFlightParams {
 // same rule: target = (margin v_fast / speed)^2 in [floor, 1] of k_scene,
 // and Δt = Δt_scene / sqrt(k_n / k_scene) (the same steps per contact).
 // The deepest contact asks for the factor that brings its overlap to the
-// design overlap (linear in the overlap: a load's overlap does not call for a
-// raise after a lowering), so a contact being compressed keeps k_n up. k_n is set to twice the target when the
-// target passes it (raised at once: the live contacts' springs are shortened
-// so that their forces stay the same, and the energy the raise injects into
-// their overlaps is measured, reported and bounded by max_injected), or when the target has stayed below a
-// quarter of it for three durations of the longest contact (lowered: the
-// energy taken out of live contacts is reported too).
+// design overlap; it holds k_n up (no lowering below it) but only speeds
+// raise k_n. k_n is set to twice the target when the target passes it
+// (raised at once: the live contacts' springs are shortened so that their
+// forces stay the same, and the energy the raise puts into their overlaps is
+// measured, reported and bounded by max_injected), or when the target has
+// stayed below a quarter of it for three durations of the longest contact
+// (lowered: the energy taken out of live contacts is reported too).
 struct ScheduleParams {
   bool enabled = false;
   double speed = 0;        // design speed of the scene's k_n, m/s (<= 0: contact.v_max)

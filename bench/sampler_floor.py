@@ -182,6 +182,23 @@ def report():
             row += ["%.5g" % m, "%.5g" % (m - half), "%.5g" % (m + half), "NA" if margin is None else int(ok)]
         lines.append("| " + " | ".join(cells) + " |")
         rows.append(row)
+    # Every kept run, bed by bed (the pairs behind the intervals above).
+    lines += ["", "Bed by bed, at %g s (wall: the whole %g s shot; `schedule` ran for 1 s on one thread):" %
+              (AT, DURATION), "",
+              "| bed | setting | " + " | ".join(lab for lab, _, _ in OUTPUTS) +
+              " | k_n at the end (of the scene's) | raises | wall (s), threads |",
+              "|---|---|" + "---|" * (len(OUTPUTS) + 3)]
+    for b in sorted(BEDS):
+        for name in SETTINGS:
+            s = load(name).get(b)
+            if s is None:
+                continue
+            q = s["run"].get("schedule")
+            at = s["bench"]["at"]
+            lines.append("| %d | `%s` | %s | %s | %s | %s |" % (
+                b, name, " | ".join("%.5g" % at[col] for _, col, _ in OUTPUTS),
+                "%.3g" % q["kn_factor_at_end"] if q else "1 (off)", q["raised"] if q else "–",
+                "%.0f, %s" % (s["run"]["wall_seconds"], s["run"].get("threads", "?"))))
     with open(os.path.join(DOCS, "sampler_floor.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     with open(os.path.join(DOCS, "sampler_floor.csv"), "w", newline="") as f:

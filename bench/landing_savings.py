@@ -83,6 +83,8 @@ setting("ga_x01_n15", "graded bed (ga), the scene's x_max 0.01, 15 steps per con
         x_max=0.01, steps=15)
 setting("ga_x05_n30", "graded bed (ga), x_max 0.05, the scene's 30 steps per contact", grading="_ga", sets=WHOLE,
         x_max=0.05, steps=30)
+# The steps per contact alone on the reference: the scene's stiffness, Delta-t twice as long.
+setting("x01_n15", "whole bed, the scene's x_max 0.01, 15 steps per contact", sets=WHOLE, x_max=0.01, steps=15)
 
 # The operator preview (config/profiles/preview.yaml: x_max 0.1, 15 steps per contact, 1 cm skin) as
 # shipped (with the zone) and on the graded beds with the whole bed free.

@@ -188,9 +188,10 @@ def report():
               "| bed | setting | " + " | ".join(lab for lab, _, _ in OUTPUTS) +
               " | k_n at the end (of the scene's) | raises | wall (s), threads |",
               "|---|---|" + "---|" * (len(OUTPUTS) + 3)]
+    kept = {name: load(name) for name in SETTINGS}
     for b in sorted(BEDS):
         for name in SETTINGS:
-            s = load(name).get(b)
+            s = kept[name].get(b)
             if s is None:
                 continue
             q = s["run"].get("schedule")

@@ -197,22 +197,17 @@ def incline():
     return out
 
 
-REPOSE_SEEDS = (11, 12, 13)  # the tall heaps' seeds (scripts/repose_tall.py PLAN)
-
-
 def repose():
     """The angle of repose of the tall poured heaps (at least 15 mean grain diameters tall), the outlet near
-    the final apex: one angle per seed, from results/repose/tall_<material>_near_s<seed>/result.json
-    (scripts/repose_tall.py; the short heaps of scripts/validate are about 6 diameters tall)."""
+    the final apex: one angle per kept run, results/repose/tall_<material>_near_s<seed>/result.json
+    (scripts/repose_tall.py, whose plan names the runs; the short heaps of scripts/validate are about 6
+    diameters tall)."""
     out = {}
     for m in MATERIALS:
-        names = ["tall_%s_near_s%d" % (m, s) for s in REPOSE_SEEDS]
-        angles = []
-        for n in names:
-            f = os.path.join(RESULTS, "repose", n, "result.json")
-            if os.path.exists(f):
-                angles.append(load_json(f)["angle_deg"])
-        out["repose.%s" % m] = (angles, "scripts/repose_tall.py run " + " ".join(names))
+        files = sorted(glob.glob(os.path.join(RESULTS, "repose", "tall_%s_near_s*" % m, "result.json")))
+        names = [os.path.basename(os.path.dirname(f)) for f in files]
+        out["repose.%s" % m] = ([load_json(f)["angle_deg"] for f in files],
+                                " ".join(["scripts/repose_tall.py run"] + names))
     return out
 
 

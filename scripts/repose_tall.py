@@ -75,7 +75,7 @@ def run_name(material, pour, seed):
 
 # The study, in the order it runs: the main moderate configuration (outlet near the apex) on three
 # seeds first, then gravel and the raised pour, then gravel's other seeds. The figures table reads the "near"
-# pours (scripts/figures.py, repose.<material>).
+# pours (scripts/figures.py, repose.<material>: every kept tall_<material>_near_s<seed>).
 PLAN = [("moderate", "near", 11), ("gravel", "near", 11), ("moderate", "high", 11), ("moderate", "near", 12),
         ("moderate", "near", 13), ("gravel", "high", 11), ("gravel", "near", 12), ("gravel", "near", 13)]
 RUNS = {run_name(*p): p for p in PLAN}

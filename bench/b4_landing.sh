@@ -13,7 +13,7 @@ ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BIN=${BIN:-$ROOT/build/devel/lib/regolith_twin}
 setting=${1:?setting}; first=${2:?first repeat}; last=${3:?last repeat}; threads=${4:-2}
 case $setting in
-  ref) args=(--set landing.active_radius=0.45) ;;   # the default of the time: the active zone
+  ref) args=(--set landing.active_radius=0.45 --set contact.steps_per_contact=30) ;;  # the default of the time
   preview|coarse2|preview_coarse2|sleep) args=(--profile "$setting") ;;
   *) echo "b4_landing: unknown setting '$setting'" >&2; exit 2 ;;
 esac

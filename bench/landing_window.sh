@@ -2,7 +2,8 @@
 # The default MASCOT landing up to a fixed time after first contact, once per
 # setting, in rounds (the settings in turn, their order reversed every other
 # round): wall time and the lander's state at the window's end, for the
-# sleeping and active-zone settings side by side (docs/bench/b2_sleeping.md).
+# sleeping and active-zone settings side by side (docs/bench/b2_sleeping.md), at the 30 steps
+# per contact the scene had when they were measured.
 #
 #   bench/landing_window.sh OUT_DIR [WINDOW_S] [ROUNDS] [THREADS] [SETTING...]
 set -euo pipefail
@@ -31,7 +32,7 @@ for ((r = 1; r <= rounds; ++r)); do
     dir=$out/$name.r$r
     # shellcheck disable=SC2086
     "$BIN/regolith_sim" "$ROOT/config/mascot_landing.yaml" --out "$dir" --threads "$threads" --quiet \
-      --set landing.max_after_contact="$window" ${SET[$name]} >/dev/null
+      --set landing.max_after_contact="$window" --set contact.steps_per_contact=30 ${SET[$name]} >/dev/null
     /usr/bin/python3 - "$dir" "$name" "$r" <<'PY'
 import json, sys, csv
 d, name, r = sys.argv[1:]

@@ -26,7 +26,7 @@ THREADS = os.environ.get("STABILITY_THREADS", "1")
 WORK = os.environ.get("STABILITY_WORK", os.path.join(ROOT, "out/stability"))  # the runs' own outputs
 
 # Steps per contact of the scene's smallest grains when its summary does not give them.
-N_RULE = {"mascot": 30}  # config/mascot_landing.yaml: steps_per_contact 30 for the smallest grains
+N_RULE = {"mascot": 30}  # sweep_mascot sets steps_per_contact 30
 
 # How a run ended, from the tool's exit code and the blow-up message (docs/model.md §13).
 GUARDS = [
@@ -159,7 +159,8 @@ def sweep_box(out):
 def sweep_mascot(out):
     cfg = os.path.join(ROOT, "config/mascot_landing.yaml")
     base = [os.path.join(BIN, "regolith_sim"), cfg, "--set", "landing.max_after_contact=0.1",
-            "--set", "landing.active_radius=0.45"]  # the active zone, as when the sweep's results were kept
+            "--set", "landing.active_radius=0.45",  # the active zone and the steps per contact, as when
+            "--set", "contact.steps_per_contact=30"]  # the sweep's results were kept
     ref = run_case("mascot", "ref", base, out, {"dt_factor": 1, "kn_factor": 1})
     kn0, dt0, bed = ref["kn"], ref["dt"], ref.get("cache")
     fixed = ["--set", "guards.allow_under_resolved=true"] + (["--relaxed-bed", bed] if bed else [])

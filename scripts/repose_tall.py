@@ -2,6 +2,7 @@
 """Angle of repose on tall poured heaps (docs/validation/repose.md).
 
   scripts/repose_tall.py run [RUN...]   runs (default: all, in the order of RUNS), one at a time
+  scripts/repose_tall.py measure RUN...  measure a run's output (out/repose/RUN) again and keep it
   scripts/repose_tall.py report         results/repose/report.md and heaps.png from the kept results
   scripts/repose_tall.py list           the runs, and which are done
 
@@ -11,7 +12,8 @@ above the base, about 0.1 m above the final apex, as in the files) or "high" (th
 hopper's grains raised by 0.40 m). Each run is one regolith_sim process on one thread at the lowest
 priority (nice 15); the raw output goes to out/repose/RUN/. A finished run leaves
 results/repose/RUN/result.json (angle per quadrant, grains on the base, heap height in mean
-grain diameters, wall and CPU time, the command) and RUN/profile.png; a run whose result.json exists is
+grain diameters, wall and CPU time, the command) and RUN/profile.png, or RUN/arched.json when the grains
+arched over the outlet and the hopper did not empty (no heap to measure); a run kept either way is
 skipped (REPOSE_RERUN=1 runs it again), so the study resumes on any machine once those files are
 committed. The angle is measured exactly as for the short heaps (scripts/lib/repose_angle.py, cone
 geometry: four quadrants, flank fits over 0.15 R <= r <= 0.85 R).
@@ -51,6 +53,9 @@ SCENES = {
 }
 OUTLET_IN_FILE = 0.45  # outlet above the base's top in the files (z = 0.46 m)
 OUTLET = {"near": 0.45, "high": 0.85}
+# A run whose hopper still holds more than this share of the poured grains when the drain stage ends
+# (the flow has stopped) arched over the outlet: it is kept as arched.json, not measured.
+ARCHED_SHARE = 0.01
 CONE_LENGTH = 0.6582  # the hopper cone, outlet radius 0.12 m to 0.5 m at 30 deg from the axis
 
 
@@ -141,10 +146,10 @@ def plot(path, res, p, title, published):
 def run_one(name, bin_dir):
     material, pour, seed = RUNS[name]
     keep = os.path.join(DOCS, name)
-    result = os.path.join(keep, "result.json")
-    if os.path.exists(result) and os.environ.get("REPOSE_RERUN") != "1":
-        print("%s: kept (%s)" % (name, os.path.relpath(result, ROOT)), flush=True)
-        return
+    for f in ("result.json", "arched.json"):
+        if os.path.exists(os.path.join(keep, f)) and os.environ.get("REPOSE_RERUN") != "1":
+            print("%s: kept (%s)" % (name, os.path.relpath(os.path.join(keep, f), ROOT)), flush=True)
+            return
     config, R, _ = SCENES[material]
     out = os.path.join(OUT, name)
     os.makedirs(out, exist_ok=True)
@@ -165,31 +170,74 @@ def run_one(name, bin_dir):
     if r.returncode != 0:
         sys.stderr.write(r.stdout[-3000:])
         raise SystemExit("%s: regolith_sim exit %d after %.0f s (nothing kept)" % (name, r.returncode, wall))
+    keep_run(name, wall, cpu, shown)
+
+
+def keep_run(name, wall, cpu, shown):
+    """Measures a finished run's output (out/repose/NAME) and keeps its figures: RUN/result.json and
+    profile.png, or RUN/arched.json when the grains arched over the outlet and the hopper did not empty
+    (no heap to measure: the settle stage would end at once with the hopper's grains hanging in the air)."""
+    material, pour, seed = RUNS[name]
+    config, R, _ = SCENES[material]
+    out, keep = os.path.join(OUT, name), os.path.join(DOCS, name)
     s = json.load(open(os.path.join(out, "summary.json")))
+    # Grains above the outlet after the fill (all poured grains) and when the drain stage ended.
+    outlet_z = BASE_TOP + OUTLET[pour]
+    poured = int(np.sum(read_snapshot(os.path.join(out, "fill.bed"))[2] > outlet_z))
+    left = int(np.sum(read_snapshot(os.path.join(out, "drain.bed"))[2] > outlet_z))
+    stages = {k: dict(t_end=v["t_end"], ended_by=v["ended_by"]) for k, v in s["stages"].items()}
+    os.makedirs(keep, exist_ok=True)
+    for f in ("result.json", "arched.json", "profile.png"):
+        if os.path.exists(os.path.join(keep, f)):
+            os.remove(os.path.join(keep, f))
+    if left > ARCHED_SHARE * poured:
+        res = dict(run=name, material=material, pour=pour, seed=seed, outlet_above_base_m=OUTLET[pour],
+                   status="arched", grains_poured=poured, grains_left_in_hopper_after_drain=left, stages=stages,
+                   sim_time_s=s["sim_time"], steps=s["steps"], wall_seconds=round(wall, 1),
+                   cpu_seconds=round(cpu, 1), threads=1, command=shown)
+        with open(os.path.join(keep, "arched.json"), "w") as f:
+            json.dump(res, f, indent=1)
+        print("%s: the grains arched over the outlet: %d of %d still in the hopper when the flow stopped at "
+              "%.2f s; no heap to measure (kept as %s)" % (name, left, poured, stages["drain"]["t_end"],
+                                                          os.path.relpath(os.path.join(keep, "arched.json"), ROOT)),
+              flush=True)
+        return
     p, res = measure(os.path.join(out, "final_grains.txt"), R)
-    # Grains still above the outlet when the drain stage ended (0: the hopper had emptied).
-    x, y, z, _ = read_snapshot(os.path.join(out, "drain.bed"))
-    left = int(np.sum(z > BASE_TOP + OUTLET[pour]))
     res = dict(
         run=name, material=material, pour=pour, seed=seed,
         outlet_above_base_m=OUTLET[pour], published_deg=PUBLISHED[material],
         **res,
+        grains_poured=poured,
         grains_left_in_hopper_after_drain=left,
-        stages={k: dict(t_end=v["t_end"], ended_by=v["ended_by"]) for k, v in s["stages"].items()},
+        stages=stages,
         sim_time_s=s["sim_time"], steps=s["steps"], kn=s["kn"], dt=s["dt"], grains=s["grains"],
         max_overlap_ratio=s["max_overlap_ratio"],
         wall_seconds=round(wall, 1), cpu_seconds=round(cpu, 1), threads=1,
         command=shown, method="poured fixed-base cone, scripts/lib/repose_angle.py (cone: four quadrants, "
                               "flank fits over 0.15 R <= r <= 0.85 R)")
-    os.makedirs(keep, exist_ok=True)
     plot(os.path.join(keep, "profile.png"), res, p, "%s, outlet %s (%.2f m), seed %d" %
          (material, pour, OUTLET[pour], seed), PUBLISHED[material])
-    with open(result, "w") as f:
+    with open(os.path.join(keep, "result.json"), "w") as f:
         json.dump(res, f, indent=1)
     print("%s: %.2f deg (quadrants %s), %d grains on the base, heap %.1f d, %s; %.0f s wall, %.0f s CPU" %
           (name, res["angle_deg"], " ".join("%.2f" % v for v in res["quadrants_deg"]), res["grains_on_base"],
            res["heap_height_diameters"], "covers the disk" if res["covers_disk"] else "DOES NOT COVER THE DISK",
            wall, cpu), flush=True)
+
+
+def remeasure(name):
+    """keep_run again on a run's output, with the wall and CPU time and command kept before."""
+    keep = os.path.join(DOCS, name)
+    old = next((json.load(open(os.path.join(keep, f))) for f in ("result.json", "arched.json")
+                if os.path.exists(os.path.join(keep, f))), None)
+    if old is None or not os.path.exists(os.path.join(OUT, name, "summary.json")):
+        raise SystemExit("%s: needs a kept run and its output in %s" % (name, os.path.relpath(OUT, ROOT)))
+    keep_run(name, old["wall_seconds"], old["cpu_seconds"], old["command"])
+
+
+def load_arched():
+    return {n: json.load(open(os.path.join(DOCS, n, "arched.json"))) for n in RUNS
+            if os.path.exists(os.path.join(DOCS, n, "arched.json"))}
 
 
 def load_done():
@@ -219,6 +267,15 @@ def report():
             r["ran_off"], "yes" if r["grains_left_in_hopper_after_drain"] == 0 else
             "no (%d left)" % r["grains_left_in_hopper_after_drain"], r["sim_time_s"], r["wall_seconds"],
             r["cpu_seconds"]))
+    arched = load_arched()
+    if arched:
+        lines += ["", "Runs in which the grains arched over the outlet (kept as `RUN/arched.json`, no heap to measure):",
+                  "", "| run | grains poured | still in the hopper when the flow stopped | drain ended at | wall time |",
+                  "|---|---|---|---|---|"]
+        for n, r in arched.items():
+            lines.append("| `%s` | %d | %d | %.2f s | %.0f s |" % (
+                n, r["grains_poured"], r["grains_left_in_hopper_after_drain"], r["stages"]["drain"]["t_end"],
+                r["wall_seconds"]))
     lines += ["", "Per material and pour (mean ± sample standard deviation over the seeds; single quadrants' range):", "",
               "| material | pour | seeds | heap height | angle | single quadrants | published |", "|---|---|---|---|---|---|---|"]
     groups = {}
@@ -258,16 +315,21 @@ def report():
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("cmd", choices=("run", "report", "list"))
+    p.add_argument("cmd", choices=("run", "measure", "report", "list"))
     p.add_argument("names", metavar="RUN", nargs="*", help="run: the runs (default: all)")
     a = p.parse_args()
     bin_dir = os.environ.get("REGOLITH_BIN", os.path.join(ROOT, "build", "devel", "lib", "regolith_twin"))
     os.makedirs(DOCS, exist_ok=True)
     if a.cmd == "list":
-        done = load_done()
+        done, arched = load_done(), load_arched()
         for n in RUNS:
-            print("%-28s %s" % (n, "done" if n in done else "-"))
+            print("%-28s %s" % (n, "done" if n in done else "arched" if n in arched else "-"))
         return
+    if a.cmd == "measure":
+        for n in a.names:
+            if n not in RUNS:
+                raise SystemExit("unknown run '%s' (%s)" % (n, " ".join(RUNS)))
+            remeasure(n)
     if a.cmd == "run":
         names = a.names or list(RUNS)
         for n in names:

@@ -29,9 +29,9 @@ def rule_contact(path, v_max, x_max, steps, density):
 
 
 def mascot_contact(path, x_max=0.01, steps=30):
-    """(k_n, dt) of the MASCOT landing's rule (config/mascot_landing.yaml: v_max 0.19 m/s, x_max 0.01 of the
-    smallest radius, 30 steps per contact, grains of 2430 kg/m^3) on the bed of this snapshot, or with
-    another x_max and steps per contact."""
+    """(k_n, dt) of the MASCOT rule (config/mascot_landing.yaml: v_max 0.19 m/s, x_max 0.01 of the smallest
+    radius, grains of 2430 kg/m^3) on the bed of this snapshot with `steps` per contact (default 30, as the
+    bed preparation and creep files have it; the landing itself has 15), or with another x_max."""
     return rule_contact(path, 0.19, x_max, steps, 2430.0)
 
 

@@ -316,5 +316,84 @@ class Gate(unittest.TestCase):
             self.assertTrue(all(p.startswith(os.path.realpath(old)) for p in gate.libraries(old).values()))
 
 
+class TallHeaps(unittest.TestCase):
+    """scripts/repose_tall.py measures a cone of known angle at that angle (every quadrant), and keeps a run
+    whose hopper did not empty as arched, without an angle."""
+
+    def setUp(self):
+        spec = importlib.util.spec_from_file_location(
+            "repose_tall", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts",
+                                        "repose_tall.py"))
+        self.rt = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(self.rt)
+        self.tmp = tempfile.mkdtemp()
+        self.rt.OUT, self.rt.DOCS = os.path.join(self.tmp, "out"), os.path.join(self.tmp, "results")
+
+    def tearDown(self):
+        shutil.rmtree(self.tmp)
+
+    @staticmethod
+    def snapshot(path, x, y, z, r):
+        with open(path, "wb") as f:
+            f.write(b"RGTWBED1" + np.array([len(x)], dtype=np.uint64).tobytes())
+            f.write(np.stack([x, y, z, r], axis=1).astype(np.float32).tobytes())
+
+    def cone(self, name, angle_deg, left_in_hopper):
+        """A run's output: glued base grains, a cone of grains whose tops lie on a surface at angle_deg
+        (apex 0.05 m past the disk's radius R, so the flank spans the fit range), the hopper full after the
+        fill and holding left_in_hopper grains when the drain stage ended."""
+        rng = np.random.default_rng(7)
+        R = self.rt.SCENES[self.rt.RUNS[name][0]][1]
+        base_top, outlet = self.rt.BASE_TOP, self.rt.BASE_TOP + self.rt.OUTLET[self.rt.RUNS[name][1]]
+        n = 60000
+        rho, phi = (R + 0.02) * np.sqrt(rng.random(n)), 2 * math.pi * rng.random(n)
+        r = np.full(n, 0.01)
+        top = base_top + (R + 0.05 - rho) * math.tan(math.radians(angle_deg))
+        x, y, z = rho * np.cos(phi), rho * np.sin(phi), top - r
+        out = os.path.join(self.rt.OUT, name)
+        os.makedirs(out)
+        with open(os.path.join(out, "final_grains.txt"), "w") as f:
+            f.write("# id x y z radius vx vy vz  (SI units)\n")
+            for i in range(n):
+                f.write("%d %.6f %.6f %.6f %.3f 0 0 0\n" % (i, x[i], y[i], z[i], r[i]))
+        hop = np.full(1000, outlet + 0.2)
+        zero = np.zeros(1000)
+        self.snapshot(os.path.join(out, "fill.bed"), zero, zero, hop, zero + 0.01)
+        z_drain = np.where(np.arange(1000) < left_in_hopper, outlet + 0.2, base_top + 0.05)
+        self.snapshot(os.path.join(out, "drain.bed"), zero, zero, z_drain, zero + 0.01)
+        stages = {k: {"t_end": t, "ended_by": "criteria"} for k, t in (("fill", 0.7), ("pour", 1.2), ("drain", 9.0),
+                                                                       ("settle", 10.0))}
+        with open(os.path.join(out, "summary.json"), "w") as f:
+            json.dump({"stages": stages, "sim_time": 10.0, "steps": 1, "kn": 1.0, "dt": 1.0, "grains": n,
+                       "max_overlap_ratio": 0.0}, f)
+
+    def test_a_cone_is_measured_at_its_angle(self):
+        for name, angle in (("tall_moderate_near_s11", 28.0), ("tall_gravel_near_s11", 48.0)):
+            self.cone(name, angle, left_in_hopper=8)
+            with contextlib.redirect_stdout(io.StringIO()):
+                self.rt.keep_run(name, 1.0, 1.0, "regolith_sim ...")
+            keep = os.path.join(self.rt.DOCS, name)
+            self.assertFalse(os.path.exists(os.path.join(keep, "arched.json")))
+            res = json.load(open(os.path.join(keep, "result.json")))
+            self.assertEqual(res["grains_poured"], 1000)
+            self.assertEqual(res["grains_left_in_hopper_after_drain"], 8)
+            for q in res["quadrants_deg"]:
+                self.assertAlmostEqual(q, angle, delta=0.1, msg=name)
+
+    def test_a_hopper_that_did_not_empty_is_kept_as_arched(self):
+        name = "tall_gravel_near_s12"
+        self.cone(name, 38.5, left_in_hopper=900)
+        with contextlib.redirect_stdout(io.StringIO()) as text:
+            self.rt.keep_run(name, 1.0, 1.0, "regolith_sim ...")
+        self.assertIn("arched over the outlet: 900 of 1000", text.getvalue())
+        keep = os.path.join(self.rt.DOCS, name)
+        self.assertFalse(os.path.exists(os.path.join(keep, "result.json")))
+        rec = json.load(open(os.path.join(keep, "arched.json")))
+        self.assertEqual((rec["status"], rec["grains_left_in_hopper_after_drain"]), ("arched", 900))
+        self.assertNotIn("angle_deg", rec)
+        self.assertEqual(list(self.rt.load_arched()), [name])
+        self.assertEqual(self.rt.load_done(), {})
+
+
 if __name__ == "__main__":
     unittest.main()

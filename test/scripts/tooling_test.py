@@ -117,6 +117,15 @@ def load_gate():
     return SourceFileLoader("gate", path).load_module()
 
 
+def load_script(folder, file):
+    """A Python script of the repository (folder/file) loaded as a module."""
+    spec = importlib.util.spec_from_file_location(
+        file[:-3], os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", folder, file))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 class KeptRuns(unittest.TestCase):
     """A benchmark run's summary is kept once, with its metadata; a run that stops keeps nothing."""
 
@@ -159,11 +168,7 @@ class SamplerFloorPairs(unittest.TestCase):
     reference is the validation's shot on each shipped bed, and a thinned series keeps the 0.2 s row."""
 
     def setUp(self):
-        spec = importlib.util.spec_from_file_location(
-            "sampler_floor", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "bench",
-                                          "sampler_floor.py"))
-        self.sf = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(self.sf)
+        self.sf = load_script("bench", "sampler_floor.py")
 
     @staticmethod
     def series(path, seg1, crater, dt=1.37e-4):
@@ -321,11 +326,7 @@ class TallHeaps(unittest.TestCase):
     whose hopper did not empty as arched, without an angle."""
 
     def setUp(self):
-        spec = importlib.util.spec_from_file_location(
-            "repose_tall", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts",
-                                        "repose_tall.py"))
-        self.rt = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(self.rt)
+        self.rt = load_script("scripts", "repose_tall.py")
         self.tmp = tempfile.mkdtemp()
         self.rt.OUT, self.rt.DOCS = os.path.join(self.tmp, "out"), os.path.join(self.tmp, "results")
 

@@ -150,7 +150,7 @@ def run_one(name, bin_dir):
         if os.path.exists(os.path.join(keep, f)) and os.environ.get("REPOSE_RERUN") != "1":
             print("%s: kept (%s)" % (name, os.path.relpath(os.path.join(keep, f), ROOT)), flush=True)
             return
-    config, R, _ = SCENES[material]
+    config = SCENES[material][0]
     out = os.path.join(OUT, name)
     os.makedirs(out, exist_ok=True)
     sets = overrides(material, pour, seed)
@@ -178,7 +178,7 @@ def keep_run(name, wall, cpu, shown):
     profile.png, or RUN/arched.json when the grains arched over the outlet and the hopper did not empty
     (no heap to measure: the settle stage would end at once with the hopper's grains hanging in the air)."""
     material, pour, seed = RUNS[name]
-    config, R, _ = SCENES[material]
+    R = SCENES[material][1]
     out, keep = os.path.join(OUT, name), os.path.join(DOCS, name)
     s = json.load(open(os.path.join(out, "summary.json")))
     # Grains above the outlet after the fill (all poured grains) and when the drain stage ended.

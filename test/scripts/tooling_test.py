@@ -340,9 +340,9 @@ class TallHeaps(unittest.TestCase):
             f.write(np.stack([x, y, z, r], axis=1).astype(np.float32).tobytes())
 
     def cone(self, name, angle_deg, left_in_hopper):
-        """A run's output: glued base grains, a cone of grains whose tops lie on a surface at angle_deg
-        (apex 0.05 m past the disk's radius R, so the flank spans the fit range), the hopper full after the
-        fill and holding left_in_hopper grains when the drain stage ended."""
+        """A run's output: a cone of grains whose tops lie on a surface at angle_deg (apex 0.05 m past the
+        disk's radius R, so the flank spans the fit range), and 1000 grains in the hopper after the fill, of
+        which left_in_hopper are still there when the drain stage ended."""
         rng = np.random.default_rng(7)
         R = self.rt.SCENES[self.rt.RUNS[name][0]][1]
         base_top, outlet = self.rt.BASE_TOP, self.rt.BASE_TOP + self.rt.OUTLET[self.rt.RUNS[name][1]]

@@ -316,7 +316,7 @@ def run_overrides(a, point, bed):
         ov += [f"materials.container.preset={mat}", f"materials.lander.preset={mat}"]
     ov += [f"landing.rim={depth:g}", f"grains.0.file={bed}", f"landing.attitude={att}",
            f"landing.angle_deg={angle:g}", f"landing.repeat={rep}"]
-    return ov + list(a.set)
+    return ov + list(a.set) + list(a.pinned)
 
 
 def run_one(a, land, point, bed, out_runs, index, total, eta_text):
@@ -385,7 +385,12 @@ def other_settings(a, p, d):
         return ""
     want = run_overrides(a, p, point_bed(a, p)[0])
     had = meta.get("overrides")
-    if meta.get("config") == a.config and had == want:
+    # A --pinned value was the scene's default when a run recorded without it was made.
+    if isinstance(had, list):
+        want_now = [o for o in want if o not in a.pinned or o in had]
+    else:
+        want_now = want
+    if meta.get("config") == a.config and had == want_now:
         return ""
     had = had if isinstance(had, list) else []
     return (f"  {meta.get('config')} --set " + " --set ".join(str(x) for x in had) + f"\nnow:\n  {a.config} --set "
@@ -420,7 +425,7 @@ def sweep(a, grid, land):
             fail(f"{d} was made with other settings:\n{other}\nuse another --out, or remove that run folder to redo it")
     # The grid of this command, for the report.
     write_json(os.path.join(a.out, "sweep.json"),
-               dict(a.grid_lists, config=a.config, bed_dir=a.bed_dir, set=a.set, threads=a.threads,
+               dict(a.grid_lists, config=a.config, bed_dir=a.bed_dir, set=a.set + a.pinned, threads=a.threads,
                     preparations=a.preparations,
                     started=time.strftime("%Y-%m-%d %H:%M:%S")))
     done_before = total - len(todo)
@@ -911,6 +916,9 @@ def make_parser():
                     help="folder of the bed snapshots mascot_<material>_d<cm>.bed (default config/beds)")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="extra override for every run (after the sweep's own)")
+    ap.add_argument("--pinned", action="append", default=[], metavar="KEY=VALUE",
+                    help="an override for every run (after --set) that holds a scene default the grid began "
+                         "with: finished runs recorded without it count as made with it")
     ap.add_argument("--threads", type=int, default=0, help="OpenMP threads per run (default: regolith_land's)")
     ap.add_argument("--jobs", type=int, default=1,
                     help="runs at the same time (default 1); e.g. --jobs 2 --threads 1 on two cores. Runs on a "
@@ -987,7 +995,7 @@ def main(argv=None):
         fail(f"--slurm-retries {a.slurm_retries}: expected 0 to 100")
     if not 0.1 <= a.slurm_poll <= 3600:
         fail(f"--slurm-poll {a.slurm_poll}: expected 0.1 to 3600 s")
-    for s in a.set:
+    for s in a.set + a.pinned:
         if "=" not in s or not s.split("=", 1)[0].strip():
             fail(f"--set '{s[:60]}': expected key=value")
     n_runs = len(mats) * len(depths) * len(atts) * len(angles) * a.repeats

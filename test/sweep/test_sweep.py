@@ -101,6 +101,27 @@ class SweepTest(unittest.TestCase):
             text = f.read()
         self.assertIn("| gravel | 0.3 | Flat | 60 | 2 | 1/2 |", text)
 
+    def test_pinned_default(self):
+        # A grid begun without a value that was then the scene's default, continued with it pinned:
+        # the finished runs count, a new run is made with it, and another value is still refused.
+        grid = ("--materials", "moderate", "--attitudes", "BCF", "--angles", "0", "--no-run-plots")
+        cmd = [sys.executable, SWEEP, "--land", FAKE, "--bed-dir", self.beds, "--out", self.out, *grid]
+        p = subprocess.run(cmd + ["--repeats", "1"], capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        p = subprocess.run(cmd + ["--repeats", "1", "--set", "landing.speed=0.19"], capture_output=True, text=True)
+        self.assertEqual(p.returncode, 2, p.stdout + p.stderr)
+        self.assertIn("other settings", p.stderr)
+        p = subprocess.run(cmd + ["--repeats", "2", "--pinned", "landing.speed=0.19"], capture_output=True,
+                           text=True)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        self.assertIn("1 already done, 1 to run", p.stdout)
+        with open(os.path.join(self.out, "runs", "moderate_d30_BCF_a0_r1", "sweep_run.json")) as f:
+            self.assertIn("landing.speed=0.19", json.load(f)["overrides"])
+        p = subprocess.run(cmd + ["--repeats", "2", "--pinned", "landing.speed=0.25"], capture_output=True,
+                           text=True)
+        self.assertEqual(p.returncode, 2, p.stdout + p.stderr)
+        self.assertIn("other settings", p.stderr)
+
     def test_parallel_jobs(self):
         # --jobs 3: runs overlap in time, and every run finishes once.
         cmd = [sys.executable, SWEEP, "--land", FAKE, "--bed-dir", self.beds, "--out", self.out,

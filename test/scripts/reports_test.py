@@ -2,8 +2,10 @@
 """Every campaign report regenerated from the committed results is the committed report: the bucket,
 inclined-plane, plume, bed and sampler reports (results/<scene>/), each run on a copy of its
 results folder (nothing under docs/ is written), with its plots drawn; and the landing-savings
-report (docs/bench/landing_report.md, savings.csv) from results/bench/landing/."""
+report (docs/bench/landing_report.md, savings.csv) from results/bench/landing/. And every shipped graded
+bed has a creep measurement within its criterion."""
 import glob
+import json
 import os
 import shutil
 import subprocess
@@ -48,6 +50,22 @@ class CampaignReports(unittest.TestCase):
         pages = sorted(os.path.basename(p) for p in glob.glob(os.path.join(DOCS, "beds", "*.md")))
         self.assertTrue(pages)
         self.regenerate("bed_campaign.py", "beds", pages)
+
+    def test_shipped_graded_beds_do_not_creep(self):
+        # Every graded bed shipped for the landing (config/beds/mascot_*_d30_g*.bed) was left alone for a
+        # landing's duration (scripts/validate_beds creep) and its surface moved by at most 0.1 mean radius.
+        graded = sorted(os.path.basename(p)[:-4] for p in glob.glob(os.path.join(ROOT, "config", "beds",
+                                                                                  "mascot_*_d30_g*.bed")))
+        self.assertTrue(graded)
+        for name in graded:
+            p = os.path.join(DOCS, "beds", "creep", name, "summary.json")
+            self.assertTrue(os.path.exists(p), "%s: no creep measurement (scripts/validate_beds creep %s)"
+                            % (name, name))
+            with open(p) as f:
+                c = json.load(f)["creep"]
+            self.assertGreaterEqual(c["free_seconds"], 10.0, name)
+            self.assertLessEqual(abs(c["drift"]), 0.1 * c["mean_radius"], "%s creeps: %+.2f mm in %g s"
+                                 % (name, 1e3 * c["drift"], c["free_seconds"]))
 
     def test_landing_savings(self):
         with tempfile.TemporaryDirectory() as tmp:

@@ -233,14 +233,18 @@ def report(docs=DOCS):
 
 def draw(rows, ref_wall, docs):
     plt = pyplot()
-    fig, axs = plt.subplots(1, len(OUTPUTS), figsize=(4.2 * len(OUTPUTS), 3.6))
+    fig, axs = plt.subplots(1, len(OUTPUTS), figsize=(4.2 * len(OUTPUTS) + 1.6, 3.6))
+    # One colour and marker per setting, the same in every panel (more settings than one palette has colours).
+    cmap = plt.get_cmap("tab20")
+    style = {name: (cmap(i % 20), "osD^v<>PX*"[i % 10]) for i, name in enumerate(rows)}
     for ax, (key, lab, margin, rel) in zip(axs, OUTPUTS):
         for name, row in rows.items():
             if key not in row:
                 continue
             m, half, _, _ = row[key]
-            ax.errorbar([row["wall"]], [m], yerr=[[half], [half]] if math.isfinite(half) else None, fmt="o",
-                        capsize=3, label=name)
+            color, marker = style[name]
+            ax.errorbar([row["wall"]], [m], yerr=[[half], [half]] if math.isfinite(half) else None, fmt=marker,
+                        color=color, capsize=3, label=name)
         ax.axhspan(-margin, margin, color="g", alpha=0.1)
         if ref_wall and ref_wall == ref_wall:
             ax.plot([ref_wall], [0], "ks", label="whole (reference)")
@@ -248,7 +252,7 @@ def draw(rows, ref_wall, docs):
         ax.set_xscale("log")
         ax.set_xlabel("wall time per landing (s)")
         ax.set_title("%s: difference%s" % (lab, " (relative)" if rel else ""), fontsize=9)
-    axs[0].legend(fontsize=6)
+    axs[-1].legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.02, 1.0))
     save_figure(fig, os.path.join(docs, "landing_savings.png"))
 
 

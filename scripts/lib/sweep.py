@@ -995,9 +995,10 @@ def main(argv=None):
         fail(f"--slurm-retries {a.slurm_retries}: expected 0 to 100")
     if not 0.1 <= a.slurm_poll <= 3600:
         fail(f"--slurm-poll {a.slurm_poll}: expected 0.1 to 3600 s")
-    for s in a.set + a.pinned:
-        if "=" not in s or not s.split("=", 1)[0].strip():
-            fail(f"--set '{s[:60]}': expected key=value")
+    for opt, values in (("--set", a.set), ("--pinned", a.pinned)):
+        for s in values:
+            if "=" not in s or not s.split("=", 1)[0].strip():
+                fail(f"{opt} '{s[:60]}': expected key=value")
     n_runs = len(mats) * len(depths) * len(atts) * len(angles) * a.repeats
     if n_runs > MAX_RUNS:
         fail(f"the grid has {n_runs} runs, more than {MAX_RUNS}: split it into several sweeps")

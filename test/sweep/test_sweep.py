@@ -121,6 +121,9 @@ class SweepTest(unittest.TestCase):
                            text=True)
         self.assertEqual(p.returncode, 2, p.stdout + p.stderr)
         self.assertIn("other settings", p.stderr)
+        p = subprocess.run(cmd + ["--repeats", "2", "--pinned", "landing.speed"], capture_output=True, text=True)
+        self.assertEqual(p.returncode, 2, p.stdout + p.stderr)
+        self.assertIn("--pinned 'landing.speed': expected key=value", p.stderr)
 
     def test_parallel_jobs(self):
         # --jobs 3: runs overlap in time, and every run finishes once.

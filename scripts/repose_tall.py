@@ -8,8 +8,9 @@
 
 Scenes: config/validation/pour_tall_moderate.yaml and pour_tall_gravel.yaml (a poured fixed-base
 cone at least 15 mean grain diameters tall). A run is one seed of one pour: "near" (the outlet 0.45 m
-above the base, about 0.1 m above the final apex, as in the files) or "high" (the outlet, plug and
-hopper's grains raised by 0.40 m). Each run is one regolith_sim process on one thread at the lowest
+above the base, about 0.1 m above the final apex, as in the files), "high" (the outlet, plug and
+hopper's grains raised by 0.40 m) or "wide" (gravel: the near pour through an outlet of radius 0.18 m
+instead of 0.12 m, over which gravel arched). Each run is one regolith_sim process on one thread at the lowest
 priority (nice 15); the raw output goes to out/repose/RUN/. A finished run leaves
 results/repose/RUN/result.json (angle per quadrant, grains on the base, heap height in mean
 grain diameters, wall and CPU time, the command) and RUN/profile.png, or RUN/arched.json when the grains
@@ -52,7 +53,10 @@ SCENES = {
     "gravel": ("config/validation/pour_tall_gravel.yaml", 0.45, (1.125, 1.475)),
 }
 OUTLET_IN_FILE = 0.45  # outlet above the base's top in the files (z = 0.46 m)
-OUTLET = {"near": 0.45, "high": 0.85}
+OUTLET = {"near": 0.45, "high": 0.85, "wide": 0.45}
+# The "wide" pour: the near pour with the outlet's radius 0.18 m (18 mean diameters instead of 12; the
+# plug 0.20 m), the hopper's cone keeping its length and top, for gravel, which arched over 0.12 m.
+WIDE_OUTLET, WIDE_PLUG = 0.18, 0.20
 # A run whose hopper still holds more than this share of the poured grains when the drain stage ends
 # (the flow has stopped) arched over the outlet: it is kept as arched.json, not measured.
 ARCHED_SHARE = 0.01
@@ -60,9 +64,12 @@ CONE_LENGTH = 0.6582  # the hopper cone, outlet radius 0.12 m to 0.5 m at 30 deg
 
 
 def overrides(material, pour, seed):
-    """--set overrides of one run: the seed, and for a raised pour the hopper (walls 2 and 3), the plug
-    (wall 4) and the hopper's grains (grains.1) moved up together."""
+    """--set overrides of one run: the seed, for a raised pour the hopper (walls 2 and 3), the plug
+    (wall 4) and the hopper's grains (grains.1) moved up together, and for a wide pour the outlet's
+    and the plug's radii."""
     out = ["seed=%d" % seed]
+    if pour == "wide":
+        out += ["walls.2.radius=%g" % WIDE_OUTLET, "walls.4.radius=%g" % WIDE_PLUG]
     shift = OUTLET[pour] - OUTLET_IN_FILE
     if abs(shift) > 1e-12:
         z_out = BASE_TOP + OUTLET[pour]
@@ -82,7 +89,8 @@ def run_name(material, pour, seed):
 # seeds first, then gravel and the raised pour, then gravel's other seeds. The figures table reads the "near"
 # pours (scripts/figures.py, repose.<material>: every kept tall_<material>_near_s<seed>).
 PLAN = [("moderate", "near", 11), ("gravel", "near", 11), ("moderate", "high", 11), ("moderate", "near", 12),
-        ("moderate", "near", 13), ("gravel", "high", 11), ("gravel", "near", 12), ("gravel", "near", 13)]
+        ("moderate", "near", 13), ("gravel", "high", 11), ("gravel", "near", 12), ("gravel", "near", 13),
+        ("gravel", "wide", 11), ("gravel", "wide", 12), ("gravel", "wide", 13)]
 RUNS = {run_name(*p): p for p in PLAN}
 
 

@@ -2,8 +2,9 @@
 """The figures table (docs/validation/figures.csv) and the reproduction page's table, from the
 committed results (docs/reproduction.md).
 
-  figures.py [--check]     write docs/validation/figures.csv and docs/reproduction.md (--check:
-                           compare with the committed files instead, exit 1 if they differ)
+  figures.py [--check]     write docs/validation/figures.csv, docs/reproduction.md and the campaign's
+                           progress in docs/validation/mascot.md (--check: compare with the committed
+                           files instead, exit 1 if they differ)
 
 Columns: id,value,sd,n,unit,command. `value` is the mean over the n runs (repeats, beds, seeds,
 aim points), `sd` their sample standard deviation (empty when n = 1), `NA` with n = 0 when not run
@@ -28,6 +29,7 @@ REPRO = os.path.join(ROOT, "docs", "reproduction.md")
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
 from stats import describe  # noqa: E402
+from sweep import variant_overrides  # noqa: E402
 
 
 def read_text(path):
@@ -61,6 +63,9 @@ def ids():
             for a in ANGLES:
                 for k in ("speed_ratio", "travel", "collision", "penetration"):
                     out.append(("mascot.d30.%s.%s.a%d.%s" % (m, att, a, k), units[k]))
+                # beyond the published set: the clear lift-off's speed ratio and travel
+                out += [("mascot.d30.%s.%s.a%d.speed_ratio_clear" % (m, att, a), "1"),
+                        ("mascot.d30.%s.%s.a%d.travel_clear" % (m, att, a), "m")]
     for d in ("d15", "d40"):
         for m in MATERIALS:
             for k in ("speed_ratio", "travel", "penetration"):
@@ -238,33 +243,63 @@ def plume():
     return out
 
 
-# MASCOT landings: the campaign records of runs on the shipped beds (grids listed here; the grids of
-# earlier beds are kept under results/campaign/lattice_beds/ and not read).
-MASCOT_GRIDS = {"first_look": "scripts/campaign first_look", "d30": "scripts/campaign a b",
-                "depths": "scripts/campaign c", "low_g": "scripts/campaign d"}
+# MASCOT landings: the campaign records of runs on the shipped beds at the default settings (grids
+# listed here; the grids of earlier beds are kept under results/campaign/lattice_beds/ and not read).
+# A record made with any other setting (an override that is neither its grid point nor an impact
+# condition: the first look's active zone, another steps per contact) is a variant and left out, so
+# that no figure pools runs made with different settings.
+MASCOT_GRIDS = {"d30": "scripts/campaign a b", "depths": "scripts/campaign c", "low_g": "scripts/campaign d"}
+MASCOT_SCENE = "mascot_landing.yaml"
 MASCOT_KEYS = {"speed_ratio": "speed_ratio", "travel": "travel_distance", "collision": "collision_duration",
                "penetration": "max_penetration", "ejected_volume": "ejected_volume"}
+# The clear lift-off (the lander off the bed for good) beside the published first loss of contact:
+# the two differ where the lander skips between two contacts (docs/validation/mascot.md).
+MASCOT_CLEAR_KEYS = {"speed_ratio_clear": "speed_ratio", "travel_clear": "travel_distance"}
+
+
+def mascot_point(record):
+    """The figure id prefix (mascot.<depth>.<material>.<attitude>.a<angle>) of a campaign record, or
+    None when it is not a finished run of the default landing at the published speed and gravity."""
+    sw, s = record.get("sweep_run", {}), record.get("summary") or {}
+    if sw.get("status") != "ok" or s.get("status") != "ok":
+        return None
+    if os.path.basename(str(sw.get("config") or MASCOT_SCENE)) != MASCOT_SCENE:
+        return None
+    if variant_overrides(sw.get("overrides", [])):
+        return None
+    inp = s["input"]
+    depth = "d%d" % round(100 * sw["depth"])
+    if abs(inp["gravity"] - 1.2e-4) < 1e-9:
+        depth += "g12"
+    elif abs(inp["gravity"] - 2.5e-4) > 1e-9 or inp.get("slope_deg", 0) != 0:
+        return None
+    if abs(inp["speed"] - 0.19) > 1e-9:
+        return None
+    return "mascot.%s.%s.%s.a%d" % (depth, sw["material"], sw["attitude"], round(sw["angle"]))
+
+
+def mascot_records(grid):
+    """(record, id prefix) of every default-landing run of a campaign grid, by file name."""
+    out = []
+    for f in sorted(glob.glob(os.path.join(RESULTS, "campaign", grid, "runs", "*.json"))):
+        r = load_json(f)
+        base = mascot_point(r)
+        if base is not None:
+            out.append((r, base))
+    return out
 
 
 def mascot():
     vals = {}
     for grid, cmd in MASCOT_GRIDS.items():
-        for f in sorted(glob.glob(os.path.join(RESULTS, "campaign", grid, "runs", "*.json"))):
-            r = load_json(f)
-            s = r.get("summary") or {}
-            if r.get("sweep_run", {}).get("status") != "ok" or s.get("status") != "ok":
-                continue
-            sw, inp, oc = r["sweep_run"], s["input"], s["outcome"]
-            depth = "d%d" % round(100 * sw["depth"])
-            if abs(inp["gravity"] - 1.2e-4) < 1e-9:
-                depth += "g12"
-            elif abs(inp["gravity"] - 2.5e-4) > 1e-9 or inp.get("slope_deg", 0) != 0:
-                continue
-            if abs(inp["speed"] - 0.19) > 1e-9:
-                continue
-            base = "mascot.%s.%s.%s.a%d" % (depth, sw["material"], sw["attitude"], round(sw["angle"]))
+        for r, base in mascot_records(grid):
+            oc = r["summary"]["outcome"]
             for k, key in MASCOT_KEYS.items():
                 vals.setdefault("%s.%s" % (base, k), ([], cmd))[0].append(oc[key])
+            clear = oc.get("clear_liftoff") or {}
+            for k, key in MASCOT_CLEAR_KEYS.items():
+                if key in clear:
+                    vals.setdefault("%s.%s" % (base, k), ([], cmd))[0].append(clear[key])
     return vals
 
 
@@ -520,15 +555,67 @@ def reproduction(rows_csv):
     return text.replace("<!-- summary -->", summary).replace("<!-- table -->", "\n".join(out))
 
 
+# --- the MASCOT campaign's progress (docs/validation/mascot.md, between its markers) ------------------
+
+MASCOT_PAGE = os.path.join(DOCS, "mascot.md")
+PROGRESS_BEGIN, PROGRESS_END = "<!-- campaign-progress -->", "<!-- /campaign-progress -->"
+CAMPAIGN1_RUNS = {"a": 30, "b": 60}  # scripts/campaign: part a (repeat 0) and part b (repeats 1, 2)
+
+
+def campaign_progress():
+    """The markdown table of every default-landing run of campaign 1 (results/campaign/d30/runs/), then
+    how far the campaign has got."""
+    order = {a: k for k, a in enumerate(ATTITUDES)}
+    recs = sorted(mascot_records("d30"), key=lambda x: (order.get(x[0]["sweep_run"]["attitude"], 9),
+                                                        x[0]["sweep_run"]["material"], x[0]["sweep_run"]["angle"],
+                                                        x[0]["sweep_run"]["repeat"]))
+    out = ["| run | first loss of contact | speed ratio | collision (s) | travel (m) | clear lift-off: "
+           "speed ratio | travel (m) | max penetration (cm) | wall (1 thread) |", "|---|---|---|---|---|---|---|---|---|"]
+    done = {"a": 0, "b": 0}
+    wall = 0.0
+    for r, _base in recs:
+        sw, oc = r["sweep_run"], r["summary"]["outcome"]
+        clear = oc.get("clear_liftoff") or {}
+        done["a" if sw["repeat"] == 0 else "b"] += 1
+        wall += sw["wall_seconds"]
+        if not oc["lifted_off"]:
+            first = "none (trapped)"
+        else:
+            first = "rising" if oc["angle_out_deg"] <= 90 else "descending (%.0f°)" % oc["angle_out_deg"]
+        out.append("| %s, %s, %g°, repeat %d | %s | %.3f | %.2f | %.2f | %s | %s | %.2f | %.1f min |" % (
+            sw["material"], sw["attitude"], sw["angle"], sw["repeat"], first, oc["speed_ratio"],
+            oc["collision_duration"], oc["travel_distance"],
+            "%.3f" % clear["speed_ratio"] if "speed_ratio" in clear else "–",
+            "%.2f" % clear["travel_distance"] if "travel_distance" in clear else "–",
+            100 * oc["max_penetration"], sw["wall_seconds"] / 60))
+    n = sum(done.values())
+    total = sum(CAMPAIGN1_RUNS.values())
+    lines = ["", "%d of the %d runs of campaign 1 are recorded (part a, repeat 0: %d of %d; part b, repeats 1 "
+             "and 2: %d of %d)." % (n, total, done["a"], CAMPAIGN1_RUNS["a"], done["b"], CAMPAIGN1_RUNS["b"])]
+    if n:
+        lines[-1] += (" They took %.1f core-hours (%.1f min a run on one core beside another run); the %d left "
+                      "would take about %.0f more at that mean, %.0f h of a 2-core machine."
+                      % (wall / 3600, wall / 60 / n, total - n, (total - n) * wall / n / 3600,
+                         (total - n) * wall / n / 3600 / 2))
+    return "\n".join(out + lines)
+
+
+def with_progress(text):
+    """The MASCOT page with the block between its markers replaced by campaign_progress()."""
+    a, b = text.index(PROGRESS_BEGIN) + len(PROGRESS_BEGIN), text.index(PROGRESS_END)
+    return text[:a] + "\n\n" + campaign_progress() + "\n\n" + text[b:]
+
+
 def main():
     rows = table()
     text = render(rows)
     page = reproduction(rows)
+    mascot_page = with_progress(read_text(MASCOT_PAGE))
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--check", action="store_true",
                    help="write nothing; fail if the committed table or page differ from what the results give")
     if p.parse_args().check:
-        for path, want in ((OUT, text), (REPRO, page)):
+        for path, want in ((OUT, text), (REPRO, page), (MASCOT_PAGE, mascot_page)):
             old = read_text(path) if os.path.exists(path) else ""
             if old != want:
                 sys.stderr.write("%s is not what the committed results give: run scripts/figures.py\n" %
@@ -539,6 +626,8 @@ def main():
         f.write(text)
     with open(REPRO, "w") as f:
         f.write(page)
+    with open(MASCOT_PAGE, "w") as f:
+        f.write(mascot_page)
     print("figures: %s (%d ids, %d with results); %s" % (os.path.relpath(OUT, ROOT), len(rows),
                                                          sum(1 for r in rows if r[1] != "NA"),
                                                          os.path.relpath(REPRO, ROOT)))

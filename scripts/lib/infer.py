@@ -24,7 +24,6 @@ import glob
 import json
 import math
 import os
-import re
 import sys
 
 from scipy.stats import chi2 as chi2_dist
@@ -33,7 +32,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, HERE)
 from stats import mean_sd  # noqa: E402
-from sweep import from_portable  # noqa: E402,F401  (the records' $ROOT paths; used by infer_cli too)
+from sweep import POINT_OVERRIDE, from_portable, variant_overrides  # noqa: E402,F401  (from_portable: the records'
+# $ROOT paths, used by infer_cli too)
 
 # Observable outcome -> (key of summary.outcome, label, scale to the plotted unit, plotted unit,
 # spread assumed when no ensemble has repeats).
@@ -47,11 +47,6 @@ OUTPUTS = {
 }
 # What a query may give as known of the impact.
 KNOWN_KEYS = ("speed", "angle_deg", "attitude", "gravity", "material", "depth")
-# --set keys a sweep writes for each grid point itself (scripts/lib/sweep.py, run_overrides), and the
-# impact conditions a run's summary states; every other override of a record makes the scene variant.
-SWEEP_POINT = re.compile(r"^(materials\.(regolith|container|lander)\.preset|landing\.rim|grains\.0\.file|"
-                         r"landing\.attitude|landing\.angle_deg|landing\.repeat)=")
-_CONDITION = re.compile(r"^landing\.(g|speed)=")
 DEFAULT_SCENE = "mascot_landing.yaml"  # a record of another scene file is a variant named after it
 GRID_ANGLES = (0.0, 15.0, 30.0, 45.0, 60.0)  # the published campaign's impact angles: proposed where not run
 INTERP_STEP = 5.0   # deg between interpolated angles
@@ -178,8 +173,7 @@ def load_runs(dirs):
                 skipped.append((f, "not a finished run"))
                 continue
             inp, out = s["input"], s["outcome"]
-            variant = tuple(sorted(o for o in meta.get("overrides", [])
-                                   if not SWEEP_POINT.match(o) and not _CONDITION.match(o)))
+            variant = variant_overrides(meta.get("overrides", []))
             scene = os.path.basename(str(meta.get("config") or DEFAULT_SCENE))
             if scene != DEFAULT_SCENE:  # another scene file: the boulder, the cliff
                 variant = (scene[:-5] if scene.endswith(".yaml") else scene,) + variant

@@ -71,7 +71,7 @@ def run_next(a, nxt, runs):
     rep = max(here or same, key=lambda r: sum(1 for x in here if x["file"].rsplit("/", 1)[0] ==
                                               r["file"].rsplit("/", 1)[0]))
     record = os.path.join(ROOT, os.path.dirname(rep["file"]))
-    extra = [infer.from_portable(o) for o in rep["overrides"] if not infer.SWEEP_POINT.match(o)]
+    extra = [infer.from_portable(o) for o in rep["overrides"] if not infer.POINT_OVERRIDE.match(o)]
     # The grid's bed preparations (sweep --preparations): repeat r lands where the grid's repeat r did.
     grid_dir = os.path.dirname(rep["file"])
     preps = max(r["preparations"] for r in runs if os.path.dirname(r["file"]) == grid_dir)

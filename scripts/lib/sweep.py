@@ -26,6 +26,7 @@ import io
 import json
 import math
 import os
+import re
 import shlex
 import shutil
 import signal
@@ -304,6 +305,20 @@ def die_with_parent():
 
 def on_signal(signum, _frame):
     raise KeyboardInterrupt(f"signal {signum}")
+
+
+# The --set keys run_overrides writes for each grid point itself, and the impact conditions a run's
+# summary states (landing.g, landing.speed). Every other override of a record (a --set given to the
+# whole sweep, a pinned value) makes a scene variant: another setting, not another grid point.
+POINT_OVERRIDE = re.compile(r"^(materials\.(regolith|container|lander)\.preset|landing\.rim|grains\.0\.file|"
+                            r"landing\.attitude|landing\.angle_deg|landing\.repeat)=")
+CONDITION_OVERRIDE = re.compile(r"^landing\.(g|speed)=")
+
+
+def variant_overrides(overrides):
+    """The overrides of a record that make it a scene variant (sorted): neither the grid point's nor
+    an impact condition."""
+    return tuple(sorted(o for o in overrides if not POINT_OVERRIDE.match(o) and not CONDITION_OVERRIDE.match(o)))
 
 
 def run_overrides(a, point, bed):

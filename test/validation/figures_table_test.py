@@ -1,6 +1,7 @@
 #!/usr/bin/python3
-"""The figures table (docs/validation/figures.csv, docs/reproduction.md) and the
-reproduction page (docs/reproduction.md): they are what the committed results give (regenerated and
+"""The figures table (docs/validation/figures.csv, docs/reproduction.md), the
+reproduction page (docs/reproduction.md) and the MASCOT campaign's table (docs/validation/mascot.md):
+they are what the committed results give (regenerated and
 compared), every id is present once, in order, and every
 row is well formed: a number or NA, NA exactly when no run is behind it (n = 0), a standard
 deviation exactly when n > 1, a unit and, for every figure with runs, the command that made them.
@@ -31,6 +32,11 @@ class FiguresTable(unittest.TestCase):
                          figures.reproduction(figures.table()),
                          "docs/reproduction.md is stale: run scripts/figures.py")
 
+    def test_committed_campaign_progress_is_what_the_results_give(self):
+        path = os.path.join(ROOT, "docs", "validation", "mascot.md")
+        self.assertEqual(figures.read_text(path), figures.with_progress(figures.read_text(path)),
+                         "docs/validation/mascot.md's campaign table is stale: run scripts/figures.py")
+
     def test_verdicts(self):
         # Within the tolerance or not, on numbers worked by hand; a figure not run gives no verdict.
         f = {"a": (10.15, None, 1), "b": (12.5, 0.1, 3), "c": (None, None, 0)}
@@ -56,7 +62,26 @@ class FiguresTable(unittest.TestCase):
                     "incline.moderate.I0", "repose.moderate", "plume.k8e6.rate", "plume.e0.6_mu1.4.rate",
                     "plume.base.peak_collision_time"):
             self.assertIn(fid, want)
-        self.assertEqual(len(want), 227)
+        self.assertEqual(len(want), 287)
+
+    def test_mascot_figures_take_the_default_landing_only(self):
+        # A record made with another setting (the first look's active zone, a pinned steps per contact)
+        # is a variant, not a repeat of the default: no figure pools it with the default's runs.
+        def record(overrides, config="$ROOT/config/mascot_landing.yaml", gravity=2.5e-4):
+            point = ["materials.regolith.preset=gravel", "landing.rim=0.3", "landing.attitude=BCF",
+                     "landing.angle_deg=30", "landing.repeat=0", "grains.0.file=$ROOT/config/beds/x.bed"]
+            return {"sweep_run": {"status": "ok", "config": config, "overrides": point + overrides,
+                                  "material": "gravel", "depth": 0.3, "attitude": "BCF", "angle": 30.0},
+                    "summary": {"status": "ok", "input": {"gravity": gravity, "speed": 0.19, "slope_deg": 0}}}
+        self.assertEqual(figures.mascot_point(record([])), "mascot.d30.gravel.BCF.a30")
+        self.assertEqual(figures.mascot_point(record(["landing.g=1.2e-4"], gravity=1.2e-4)),
+                         "mascot.d30g12.gravel.BCF.a30")
+        self.assertIsNone(figures.mascot_point(record(["landing.active_radius=0.45"])))
+        self.assertIsNone(figures.mascot_point(record(["contact.steps_per_contact=30"])))
+        self.assertIsNone(figures.mascot_point(record([], config="$ROOT/config/mascot_boulder.yaml")))
+        failed = record([])
+        failed["summary"]["status"] = "blown_up"
+        self.assertIsNone(figures.mascot_point(failed))
 
     def test_rows_are_well_formed(self):
         for r in self.rows:

@@ -29,7 +29,7 @@ REPRO = os.path.join(ROOT, "docs", "reproduction.md")
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
 from stats import describe  # noqa: E402
-from sweep import variant_overrides  # noqa: E402
+from sweep import DEFAULT_SCENE, variant_overrides  # noqa: E402
 
 
 def read_text(path):
@@ -249,7 +249,6 @@ def plume():
 # condition: the first look's active zone, another steps per contact) is a variant and left out, so
 # that no figure pools runs made with different settings.
 MASCOT_GRIDS = {"d30": "scripts/campaign a b", "depths": "scripts/campaign c", "low_g": "scripts/campaign d"}
-MASCOT_SCENE = "mascot_landing.yaml"
 MASCOT_KEYS = {"speed_ratio": "speed_ratio", "travel": "travel_distance", "collision": "collision_duration",
                "penetration": "max_penetration", "ejected_volume": "ejected_volume"}
 # The clear lift-off (the lander off the bed for good) beside the published first loss of contact:
@@ -263,7 +262,7 @@ def mascot_point(record):
     sw, s = record.get("sweep_run", {}), record.get("summary") or {}
     if sw.get("status") != "ok" or s.get("status") != "ok":
         return None
-    if os.path.basename(str(sw.get("config") or MASCOT_SCENE)) != MASCOT_SCENE:
+    if os.path.basename(str(sw.get("config") or DEFAULT_SCENE)) != DEFAULT_SCENE:
         return None
     if variant_overrides(sw.get("overrides", [])):
         return None

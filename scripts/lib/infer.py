@@ -32,8 +32,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, HERE)
 from stats import mean_sd  # noqa: E402
-from sweep import POINT_OVERRIDE, from_portable, variant_overrides  # noqa: E402,F401  (from_portable: the records'
-# $ROOT paths, used by infer_cli too)
+# DEFAULT_SCENE: a record of another scene file is a variant named after it; from_portable: the records'
+# $ROOT paths (used by infer_cli too)
+from sweep import DEFAULT_SCENE, POINT_OVERRIDE, from_portable, variant_overrides  # noqa: E402,F401
 
 # Observable outcome -> (key of summary.outcome, label, scale to the plotted unit, plotted unit,
 # spread assumed when no ensemble has repeats).
@@ -47,7 +48,6 @@ OUTPUTS = {
 }
 # What a query may give as known of the impact.
 KNOWN_KEYS = ("speed", "angle_deg", "attitude", "gravity", "material", "depth")
-DEFAULT_SCENE = "mascot_landing.yaml"  # a record of another scene file is a variant named after it
 GRID_ANGLES = (0.0, 15.0, 30.0, 45.0, 60.0)  # the published campaign's impact angles: proposed where not run
 INTERP_STEP = 5.0   # deg between interpolated angles
 INTERP_SPREADS = 2  # neighbours whose means differ by less than this many pooled spreads are interpolated

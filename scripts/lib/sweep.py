@@ -307,6 +307,7 @@ def on_signal(signum, _frame):
     raise KeyboardInterrupt(f"signal {signum}")
 
 
+DEFAULT_SCENE = "mascot_landing.yaml"  # the landing a sweep runs unless --config names another scene file
 # The --set keys run_overrides writes for each grid point itself, and the impact conditions a run's
 # summary states (landing.g, landing.speed). Every other override of a record (a --set given to the
 # whole sweep, a pinned value) makes a scene variant: another setting, not another grid point.
@@ -925,7 +926,7 @@ def make_parser():
     ap.add_argument("--preparations", type=int, default=1, metavar="K",
                     help="independent bed preparations (default 1): repeat r lands on preparation r mod K + 1 "
                          "(mascot_<material>_d<cm>_s<k>.bed for k > 1), perturbed r div K times over")
-    ap.add_argument("--config", default=os.path.join(ROOT, "config", "mascot_landing.yaml"),
+    ap.add_argument("--config", default=os.path.join(ROOT, "config", DEFAULT_SCENE),
                     help="landing file (default config/mascot_landing.yaml)")
     ap.add_argument("--bed-dir", default=os.path.join(ROOT, "config", "beds"),
                     help="folder of the bed snapshots mascot_<material>_d<cm>.bed (default config/beds)")
